@@ -1,0 +1,65 @@
+#pragma once
+
+#include <string>
+
+#include <Eigen/Geometry>
+
+namespace tubepick {
+
+/// Unit in which a cloud's coordinates arrive.
+enum class LengthUnit { kMetre, kMillimetre };
+
+/// Scale factor from `unit` to metres.
+double MetresPer(LengthUnit unit);
+/// "m" or "mm". @throws InvalidArgument for anything else, naming `field`.
+LengthUnit ParseLengthUnit(const std::string& text, const std::string& field);
+std::string ToString(LengthUnit unit);
+
+/// The bin: origin at the centre of its floor, z up, x along its length.
+struct BinConfig {
+  /// Inner length (x), width (y) and wall height (z), metres.
+  Eigen::Vector3d inner_size{0.80, 0.60, 0.20};
+};
+
+struct SensorConfig {
+  /// X_BinSensor: pose of the sensor's optical frame (x right, y down, z forward) in the bin frame.
+  Eigen::Isometry3d X_BinSensor = DefaultX_BinSensor();
+  /// Unit of the clouds this sensor produces.
+  LengthUnit unit = LengthUnit::kMetre;
+
+  /// 1.1 m above the floor centre, looking straight down (optical z = -bin z).
+  static Eigen::Isometry3d DefaultX_BinSensor();
+};
+
+struct TubeConfig {
+  /// Tube radius, metres.
+  double radius = 0.0125;
+  /// Expected curve length, metres; 0 = unknown.
+  double length = 0.50;
+  /// Mass of one tube, kg.
+  double mass = 0.055;
+};
+
+/// Where placed tubes go: X_BinPlace is the destination frame the tube's PCA frame is aligned
+/// with, expressed in the bin frame.
+struct PlaceConfig {
+  Eigen::Isometry3d X_BinPlace = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.8, 0.1));
+};
+
+/// One robot cell (ARCHITECTURE.md, "Cell description").
+struct CellConfig {
+  BinConfig bin;
+  SensorConfig sensor;
+  TubeConfig tube;
+  PlaceConfig place;
+
+  /// @throws InvalidArgument naming the field when a value is non-finite or out of range.
+  void Validate() const;
+};
+
+/// Loads a cell YAML. Unknown keys are errors.
+/// @throws InvalidArgument with the key path and the reason.
+CellConfig LoadCellConfig(const std::string& path);
+CellConfig ParseCellConfig(const std::string& yaml_text);
+
+}  // namespace tubepick

@@ -1,0 +1,81 @@
+#include "core/common/cell_config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/common/errors.h"
+
+namespace tubepick {
+namespace {
+
+using ::testing::HasSubstr;
+constexpr double kTol = 1e-12;
+
+TEST(CellConfig, ParsesArchitectureExample) {
+  const CellConfig cell = ParseCellConfig(R"(
+bin:
+  inner_size: [0.80, 0.60, 0.20]
+sensor:
+  pose_in_bin:
+    position: [0.0, 0.0, 1.1]
+    orientation_xyzw: [1.0, 0.0, 0.0, 0.0]
+  unit: mm
+tube:
+  radius: 0.0125
+  length: 0.50
+  mass: 0.055
+)");
+  EXPECT_NEAR(cell.bin.inner_size.x(), 0.80, kTol);
+  EXPECT_EQ(cell.sensor.unit, LengthUnit::kMillimetre);
+  // Optical z looks down the bin's −z.
+  const Eigen::Vector3d z_Bin = cell.sensor.X_BinSensor.linear() * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(z_Bin.z(), -1.0, kTol);
+  EXPECT_NEAR(cell.sensor.X_BinSensor.translation().z(), 1.1, kTol);
+  EXPECT_NEAR(cell.tube.mass, 0.055, kTol);
+}
+
+TEST(CellConfig, DefaultsMatchDefaultPose) {
+  const CellConfig cell = ParseCellConfig("{}");
+  EXPECT_TRUE(cell.sensor.X_BinSensor.isApprox(SensorConfig::DefaultX_BinSensor()));
+}
+
+TEST(CellConfig, RejectsUnknownKeyNamingIt) {
+  try {
+    ParseCellConfig("tube:\n  radius: 0.01\n  colour: red\n");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("tube.colour"));
+  }
+}
+
+TEST(CellConfig, RejectsOutOfRangeRadius) {
+  try {
+    ParseCellConfig("tube:\n  radius: -0.01\n");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("tube.radius"));
+  }
+}
+
+TEST(CellConfig, RejectsNonUnitQuaternionAndUnknownUnit) {
+  EXPECT_THROW(ParseCellConfig("sensor:\n  pose_in_bin:\n    orientation_xyzw: [1, 1, 0, 0]\n"), InvalidArgument);
+  try {
+    ParseCellConfig("sensor:\n  unit: inch\n");
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("sensor.unit"));
+    EXPECT_THAT(e.what(), HasSubstr("inch"));
+  }
+}
+
+TEST(CellConfig, ReportsYamlSyntaxErrorWithLine) {
+  try {
+    ParseCellConfig("bin: [1, 2\n");
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("line"));
+  }
+}
+
+}  // namespace
+}  // namespace tubepick

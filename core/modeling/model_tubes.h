@@ -1,0 +1,66 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/cell_config.h"
+#include "core/common/stop_token.h"
+#include "core/common/types.h"
+#include "core/modeling/modeling_params.h"
+
+namespace tubepick {
+
+struct ModelingInput {
+  /// The cloud as the scanner gives it: sensor optical frame, in `unit`.
+  const Points* points_Sensor = nullptr;
+  LengthUnit unit = LengthUnit::kMetre;
+  Eigen::Isometry3d X_BinSensor = SensorConfig::DefaultX_BinSensor();
+  BinConfig bin;
+  /// Drives every random choice: same cloud + seed ⇒ same tubes.
+  std::uint64_t seed = 0;
+};
+
+struct StageTiming {
+  std::string stage;  ///< "prepare", "filter", "normals", "segmentation", "cylinders", "joining"
+  double seconds = 0.0;
+};
+
+struct StepCount {
+  std::string step;  ///< "input", "finite", each filter step by name, "normals", "segmented", ...
+  std::uint64_t points = 0;
+};
+
+struct ModelingResult {
+  std::vector<Tube> tubes;
+  /// Highest z of the filtered cloud (max_z of Equation 5.4), metres; 0 when it is empty.
+  double max_height = 0.0;
+  std::uint64_t input_points = 0;
+  std::uint64_t dropped_non_finite = 0;
+  std::uint32_t segment_count = 0;
+  std::uint32_t cylinder_count = 0;
+  std::vector<StepCount> counts;
+  std::vector<StageTiming> timings;
+  double total_seconds = 0.0;
+
+  /// The finite input in the bin frame (for grasp collision checks and evaluation).
+  Points raw_Bin;
+  /// The filtered cloud (with normals) that was segmented.
+  OrientedPoints filtered;
+  /// Per filtered point: its segment, or −1.
+  std::vector<std::int32_t> segment_of_point;
+  /// Per filtered point: the tube whose cylinder took it as an inlier, or −1.
+  std::vector<std::int32_t> tube_of_point;
+};
+
+/// Runs Algorithm 1: prepare → filters (+ normals) → region growing → cylinders → joining.
+/// @throws InvalidArgument for an empty / all-non-finite cloud or invalid parameters.
+/// @throws Cancelled when `stop` fires (polled inside every stage).
+ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params,
+                          const StopToken* stop = nullptr);
+
+/// Writes the stage clouds as PLY into `directory` (created if missing): 1_filtered.ply,
+/// 2_segments.ply (coloured by segment), 3_tubes.ply (cylinder inliers coloured by tube).
+void DumpStages(const ModelingResult& result, const std::string& directory);
+
+}  // namespace tubepick

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/common/stop_token.h"
+#include "core/common/types.h"
+
+namespace tubepick {
+
+/// Region growing (Rabbani et al. 2006, pcl::RegionGrowing), Table 4.3.
+struct SegmentationParams {
+  /// Clusters smaller than this are discarded.
+  std::uint32_t min_cluster_size = 100;
+  std::uint32_t max_cluster_size = 1000000;
+  /// k of the k-nearest-neighbour graph.
+  std::uint32_t neighbours = 77;
+  /// Maximum angle between neighbouring normals to grow a region, radians (Table 4.3: 5°).
+  double smoothness_threshold = 5.0 * 3.14159265358979323846 / 180.0;
+  /// Points with curvature below this become seeds of the region they join.
+  double curvature_threshold = 0.2;
+  /// When true, also requires a neighbour's distance to the seed's tangent plane to be below
+  /// residual_threshold (metres).
+  bool residual_test = false;
+  double residual_threshold = 10.0;
+};
+
+/// A segment: indices into the segmented cloud.
+using Segment = std::vector<std::uint32_t>;
+
+/// Splits the cloud into smooth regions. Deterministic: seeds are taken in order of increasing
+/// curvature (ties by index). Segments are returned in the order they were grown; each index
+/// appears in at most one segment.
+/// @throws InvalidArgument for neighbours == 0 or a non-positive smoothness threshold.
+std::vector<Segment> SegmentRegions(const OrientedPoints& cloud, const SegmentationParams& params,
+                                    const StopToken* stop = nullptr);
+
+}  // namespace tubepick

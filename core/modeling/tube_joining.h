@@ -1,0 +1,67 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/common/stop_token.h"
+#include "core/common/types.h"
+#include "core/modeling/range_image.h"
+
+namespace tubepick {
+
+enum class JoiningStrategy {
+  /// Thesis Algorithm 1 lines 9–17: pairs in ascending combined distance, greedily.
+  kGreedy,
+  /// Global assignment: endpoint pairs chosen to minimise the summed distance over all joins
+  /// (subject to the same constraints), avoiding the greedy order's mis-joins.
+  kGlobal,
+};
+
+/// Tube joining (thesis §4.3.4, Table 4.3).
+struct JoiningParams {
+  /// Maximum euclidean distance between joined endpoints, metres.
+  double max_distance = 0.10;
+  /// Maximum angular distance α+β, radians (Table 4.3: 90°).
+  double max_angle = 3.14159265358979323846 / 2.0;
+  /// c_Δθ in metres per radian (Table 4.3: 0.001 m per degree = 0.0573 m/rad).
+  double angular_weight = 0.001 * 180.0 / 3.14159265358979323846;
+  /// Length constraint: joined tubes may not exceed this, metres; 0 disables it.
+  double max_tube_length = 0.60;
+  /// Euclidean distance below which the angular distance counts as 0 (the radius shortcut);
+  /// 0 = use the mean radius of the two cylinders, as the thesis.
+  double radius_shortcut = 0.0;
+  /// Visibility constraint: a gap is joined only if something in the range image lies between
+  /// it and the sensor (or the gap is shorter than visibility_min_gap).
+  bool visibility_check = true;
+  /// Angular pixel size of the range image, radians.
+  double visibility_pixel_angle = 0.002;
+  /// Half-size of the pixel window searched around the gap's midpoint.
+  std::uint32_t visibility_window = 2;
+  /// Gaps shorter than this are joined without the visibility test, metres (touching ends).
+  double visibility_min_gap = 0.0;
+  JoiningStrategy strategy = JoiningStrategy::kGreedy;
+};
+
+/// Endpoint-pair distance terms, exposed for tests.
+struct JoinDistance {
+  double euclidean = 0.0;
+  /// α + β, radians; 0 when the radius shortcut applies.
+  double angular = 0.0;
+  /// euclidean + angular_weight · angular (Equation 4.2).
+  double combined = 0.0;
+};
+
+/// Distance between endpoint `a` of a cylinder with outward axis `a_out` (pointing away from the
+/// cylinder at that end) and endpoint `b` with outward axis `b_out`.
+JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a_out,
+                              const Eigen::Vector3d& b, const Eigen::Vector3d& b_out,
+                              double shortcut_radius, const JoiningParams& params);
+
+/// Joins cylinders into tubes. Every cylinder starts as its own tube; compatible endpoint pairs
+/// of different tubes are united (different tubes, distance and angle limits, length constraint,
+/// visibility constraint when `visibility` is non-null and enabled). In each output tube the
+/// cylinders are ordered and oriented along the tube. Tube ids are 0..n−1, longest tube first.
+std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
+                            const RangeImage* visibility, const StopToken* stop = nullptr);
+
+}  // namespace tubepick
