@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "core/common/cell_config.h"
 #include "core/common/types.h"
@@ -12,6 +14,8 @@ struct PreparedCloud {
   Points points_Bin;
   /// Points dropped because a coordinate was NaN or infinite.
   std::size_t dropped_non_finite = 0;
+  /// Index in the input of each kept point; empty when nothing was dropped (identity).
+  std::vector<std::uint32_t> source_index;
 };
 
 /// Scales `points_Sensor` from `unit` to metres, drops non-finite points and transforms the rest

@@ -47,6 +47,9 @@ struct ModelingResult {
   Points raw_Bin;
   /// The filtered cloud (with normals) that was segmented.
   OrientedPoints filtered;
+  /// Per filtered point: its index in the input cloud (ModelingInput::points_Sensor), so per-point
+  /// ground truth can be looked up.
+  std::vector<std::uint32_t> filtered_source_index;
   /// Per filtered point: its segment, or −1.
   std::vector<std::int32_t> segment_of_point;
   /// Per filtered point: the tube whose cylinder took it as an inlier, or −1.

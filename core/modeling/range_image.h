@@ -14,12 +14,16 @@ namespace tubepick {
 /// stores the smallest depth (optical z) of the points that fall in it.
 class RangeImage {
  public:
-  /// @param pixel_angle angular pixel size, radians (> 0).
+  /// @param pixel_angle angular pixel size, radians (> 0). The image spans the angular extent
+  ///        of the points in front of the sensor; an empty cloud gives a 0 × 0 image.
+  /// @throws InvalidArgument for a non-positive pixel_angle, a non-finite pose, or an image that
+  ///         would exceed 64 Mi pixels (named "pixel_angle").
   RangeImage(const Points& points_Bin, const Eigen::Isometry3d& X_BinSensor, double pixel_angle);
 
   /// True when some pixel within `window` pixels (Chebyshev) of the projection of the midpoint
   /// of the projections of `a_Bin` and `b_Bin` holds a depth smaller than the larger depth of the
-  /// two endpoints minus `margin`: something lies between the gap and the sensor.
+  /// two endpoints minus `margin`: something lies between the gap and the sensor. False when the
+  /// midpoint falls outside the image or an endpoint is not in front of the sensor.
   bool IsGapCovered(const Eigen::Vector3d& a_Bin, const Eigen::Vector3d& b_Bin, int window,
                     double margin = 0.0) const;
 

@@ -13,7 +13,9 @@ enum class JoiningStrategy {
   /// Thesis Algorithm 1 lines 9–17: pairs in ascending combined distance, greedily.
   kGreedy,
   /// Global assignment: endpoint pairs chosen to minimise the summed distance over all joins
-  /// (subject to the same constraints), avoiding the greedy order's mis-joins.
+  /// (subject to the same constraints), avoiding the greedy order's mis-joins. Exactly: the join
+  /// set maximising Σ (max_distance + angular_weight·max_angle − combined), so more useful joins
+  /// win first, then a smaller total distance (branch and bound, see tube_joining.cc).
   kGlobal,
 };
 
@@ -52,7 +54,9 @@ struct JoinDistance {
 };
 
 /// Distance between endpoint `a` of a cylinder with outward axis `a_out` (pointing away from the
-/// cylinder at that end) and endpoint `b` with outward axis `b_out`.
+/// cylinder at that end) and endpoint `b` with outward axis `b_out` (need not be unit). α is the
+/// angle between `a_out` and b − a, β between `b_out` and a − b; the angular term is 0 when the
+/// euclidean distance is below `shortcut_radius` (or 0).
 JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a_out,
                               const Eigen::Vector3d& b, const Eigen::Vector3d& b_out,
                               double shortcut_radius, const JoiningParams& params);
@@ -61,6 +65,10 @@ JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a
 /// of different tubes are united (different tubes, distance and angle limits, length constraint,
 /// visibility constraint when `visibility` is non-null and enabled). In each output tube the
 /// cylinders are ordered and oriented along the tube. Tube ids are 0..n−1, longest tube first.
+/// Deterministic: the same input gives the same output.
+/// @throws InvalidArgument for an invalid parameter (naming "joining.<key>" and the value) or a
+///         non-finite cylinder (naming "cylinders[i]").
+/// @throws Cancelled when `stop` fires.
 std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
                             const RangeImage* visibility, const StopToken* stop = nullptr);
 

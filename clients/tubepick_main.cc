@@ -1,0 +1,32 @@
+// tubepick: command-line front end of the planning library (model, params, bench, ...).
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include "clients/cli/bench_command.h"
+#include "clients/cli/model_command.h"
+#include "clients/cli/params_command.h"
+#include "core/common/errors.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"tubepick - bin picking of entangled tubes"};
+  app.require_subcommand(1);
+  std::string log_level = "warn";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str();
+  app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
+  tubepick::cli::AddModelCommand(app);
+  tubepick::cli::AddParamsCommand(app);
+  tubepick::cli::AddBenchCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const tubepick::InvalidArgument& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "internal error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

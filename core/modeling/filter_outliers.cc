@@ -1,0 +1,108 @@
+// radius_outlier and statistical_outlier: neighbourhood-density filters on a k-d tree
+// (the semantics of pcl::RadiusOutlierRemoval and pcl::StatisticalOutlierRemoval).
+
+#include <algorithm>
+#include <cmath>
+
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "core/modeling/filters_internal.h"
+
+namespace tubepick::internal {
+namespace {
+
+/// The cloud as PCL points; non-finite points stay in place (is_dense false) and the tree skips them.
+pcl::PointCloud<pcl::PointXYZ>::Ptr ToPcl(const Points& points, std::size_t* finite_count) {
+  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->resize(points.size());
+  *finite_count = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    (*cloud)[i].getVector3fMap() = points[i];
+    *finite_count += points[i].allFinite() ? 1 : 0;
+  }
+  cloud->width = static_cast<std::uint32_t>(points.size());
+  cloud->height = 1;
+  cloud->is_dense = *finite_count == points.size();
+  return cloud;
+}
+
+std::vector<std::uint32_t> FiniteIndices(const Points& points) {
+  std::vector<std::uint32_t> kept;
+  kept.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].allFinite()) kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  return kept;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> RadiusOutlierFilter(const RadiusOutlierParams& params, const Points& points_Bin,
+                                               const StopToken* stop) {
+  if (params.min_neighbours == 0) return FiniteIndices(points_Bin);
+  std::size_t finite_count = 0;
+  const auto cloud = ToPcl(points_Bin, &finite_count);
+  std::vector<std::uint32_t> kept;
+  if (finite_count <= params.min_neighbours) return kept;  // nobody can have enough neighbours
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;                    // sorted results: the last is the farthest
+  tree.setInputCloud(cloud);
+  // The point itself is its own nearest neighbour: it has min_neighbours others within the radius
+  // exactly when its (min_neighbours + 1)-th nearest point is within the radius.
+  const int k = static_cast<int>(params.min_neighbours) + 1;
+  const float radius_squared = static_cast<float>(params.radius * params.radius);
+  pcl::Indices neighbours(k);
+  std::vector<float> squared_distances(k);
+  kept.reserve(points_Bin.size());
+  for (std::size_t i = 0; i < points_Bin.size(); ++i) {
+    if (i % kStopPollInterval == 0) ThrowIfStopped(stop, "filter radius_outlier");
+    if (!points_Bin[i].allFinite()) continue;
+    const int found = tree.nearestKSearch((*cloud)[i], k, neighbours, squared_distances);
+    if (found == k && squared_distances[k - 1] <= radius_squared)
+      kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  return kept;
+}
+
+std::vector<std::uint32_t> StatisticalOutlierFilter(const StatisticalOutlierParams& params,
+                                                    const Points& points_Bin, const StopToken* stop) {
+  std::size_t finite_count = 0;
+  const auto cloud = ToPcl(points_Bin, &finite_count);
+  if (finite_count < 3) return FiniteIndices(points_Bin);  // no meaningful statistics
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  // With fewer points than asked for, every point uses all the others.
+  const int mean_k = static_cast<int>(std::min<std::size_t>(params.neighbours, finite_count - 1));
+  pcl::Indices neighbours(mean_k + 1);
+  std::vector<float> squared_distances(mean_k + 1);
+
+  // Pass 1: mean distance of each point to its mean_k nearest neighbours (result 0 is itself).
+  std::vector<double> mean_distance(points_Bin.size(), 0.0);
+  double sum = 0.0, sum_squares = 0.0;
+  for (std::size_t i = 0; i < points_Bin.size(); ++i) {
+    if (i % kStopPollInterval == 0) ThrowIfStopped(stop, "filter statistical_outlier");
+    if (!points_Bin[i].allFinite()) continue;
+    const int found = tree.nearestKSearch((*cloud)[i], mean_k + 1, neighbours, squared_distances);
+    double distance_sum = 0.0;
+    for (int j = 1; j < found; ++j) distance_sum += std::sqrt(static_cast<double>(squared_distances[j]));
+    mean_distance[i] = distance_sum / mean_k;
+    sum += mean_distance[i];
+    sum_squares += mean_distance[i] * mean_distance[i];
+  }
+
+  // Pass 2: keep d <= μ + mult·σ (thesis Eq. 4.1; σ with Bessel's correction, as PCL).
+  const double n = static_cast<double>(finite_count);
+  const double mean = sum / n;
+  const double variance = std::max(0.0, (sum_squares - sum * sum / n) / (n - 1.0));
+  const double threshold = mean + params.stddev_mult * std::sqrt(variance);
+  std::vector<std::uint32_t> kept;
+  kept.reserve(points_Bin.size());
+  for (std::size_t i = 0; i < points_Bin.size(); ++i) {
+    if (points_Bin[i].allFinite() && mean_distance[i] <= threshold)
+      kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  return kept;
+}
+
+}  // namespace tubepick::internal

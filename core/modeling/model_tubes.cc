@@ -1,0 +1,235 @@
+#include "core/modeling/model_tubes.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <tuple>
+
+#include <spdlog/spdlog.h>
+
+#include "core/common/errors.h"
+#include "core/modeling/cloud_io.h"
+#include "core/modeling/cloud_prepare.h"
+#include "core/modeling/cylinder_fit.h"
+#include "core/modeling/range_image.h"
+#include "core/modeling/tube_joining.h"
+
+namespace tubepick {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// SplitMix64: derives independent, reproducible seeds for each stochastic step.
+std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+template <typename T>
+std::vector<T> Subset(const std::vector<T>& values, const std::vector<std::uint32_t>& keep) {
+  std::vector<T> out;
+  out.reserve(keep.size());
+  for (std::uint32_t i : keep) out.push_back(values[i]);
+  return out;
+}
+
+// The working cloud of the filter pipeline: points, and normals once estimated.
+struct WorkingCloud {
+  OrientedPoints cloud;
+  std::vector<std::uint32_t> source_index;  // index in the input cloud
+  bool has_normals = false;
+
+  void Keep(const std::vector<std::uint32_t>& keep) {
+    cloud.points = Subset(cloud.points, keep);
+    source_index = Subset(source_index, keep);
+    if (has_normals) {
+      cloud.normals = Subset(cloud.normals, keep);
+      cloud.curvature = Subset(cloud.curvature, keep);
+    }
+  }
+};
+
+int ThreadCount(std::uint32_t requested) {
+  return requested == 0 ? omp_get_max_threads() : static_cast<int>(requested);
+}
+
+}  // namespace
+
+ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params, const StopToken* stop) {
+  if (input.points_Sensor == nullptr) throw InvalidArgument("cloud: no points given");
+  params.Validate();
+  const Clock::time_point t_start = Clock::now();
+  ModelingResult result;
+
+  // 1. Prepare: units, NaN removal, bin frame.
+  Clock::time_point t0 = Clock::now();
+  PreparedCloud prepared = PrepareCloud(*input.points_Sensor, input.unit, input.X_BinSensor);
+  result.input_points = input.points_Sensor->size();
+  result.dropped_non_finite = prepared.dropped_non_finite;
+  result.raw_Bin = std::move(prepared.points_Bin);
+  result.counts.push_back({"input", result.input_points});
+  result.counts.push_back({"finite", result.raw_Bin.size()});
+  result.timings.push_back({"prepare", SecondsSince(t0)});
+  ThrowIfStopped(stop, "prepare");
+
+  // 2. Filters, with normals estimated when first needed (or after the last filter).
+  const FilterContext context{input.X_BinSensor, input.bin};
+  const Eigen::Vector3f viewpoint_Bin = input.X_BinSensor.translation().cast<float>();
+  WorkingCloud work;
+  double filter_seconds = 0.0, normal_seconds = 0.0;
+  auto estimate_normals = [&]() {
+    const Clock::time_point tn = Clock::now();
+    const Points& surface =
+        params.normals.search_surface == SearchSurface::kRaw ? result.raw_Bin : work.cloud.points;
+    OrientedPoints oriented =
+        EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop);
+    std::vector<std::uint32_t> valid;
+    valid.reserve(oriented.size());
+    for (std::uint32_t i = 0; i < oriented.size(); ++i) {
+      if (oriented.normals[i].allFinite() && std::isfinite(oriented.curvature[i])) valid.push_back(i);
+    }
+    work.cloud = std::move(oriented);  // same points, same order: source_index still holds
+    work.has_normals = true;
+    if (valid.size() != work.cloud.size()) work.Keep(valid);
+    result.counts.push_back({"normals", work.cloud.size()});
+    normal_seconds += SecondsSince(tn);
+  };
+
+  work.cloud.points = result.raw_Bin;
+  if (prepared.source_index.empty()) {
+    work.source_index.resize(result.raw_Bin.size());
+    for (std::uint32_t i = 0; i < work.source_index.size(); ++i) work.source_index[i] = i;
+  } else {
+    work.source_index = std::move(prepared.source_index);
+  }
+  for (std::size_t i = 0; i < params.filters.size(); ++i) {
+    const FilterStep& step = params.filters[i];
+    if (FilterNeedsNormals(step) && !work.has_normals) estimate_normals();
+    const Clock::time_point tf = Clock::now();
+    const auto keep = ApplyFilter(step, work.cloud.points, work.has_normals ? &work.cloud.normals : nullptr,
+                                  context, MixSeed(input.seed, i), stop);
+    work.Keep(keep);
+    result.counts.push_back({FilterName(step), work.cloud.size()});
+    filter_seconds += SecondsSince(tf);
+  }
+  if (!work.has_normals) estimate_normals();
+  result.timings.push_back({"filter", filter_seconds});
+  result.timings.push_back({"normals", normal_seconds});
+  result.filtered = std::move(work.cloud);
+  result.filtered_source_index = std::move(work.source_index);
+  const OrientedPoints& cloud = result.filtered;
+  for (const auto& p : cloud.points)
+    result.max_height = std::max(result.max_height, static_cast<double>(p.z()));
+  ThrowIfStopped(stop, "filter");
+
+  // 3. Region-growing segmentation.
+  t0 = Clock::now();
+  const std::vector<Segment> segments = SegmentRegions(cloud, params.segmentation, stop);
+  result.segment_count = static_cast<std::uint32_t>(segments.size());
+  result.segment_of_point.assign(cloud.size(), -1);
+  std::uint64_t segmented = 0;
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    for (std::uint32_t i : segments[s]) result.segment_of_point[i] = static_cast<std::int32_t>(s);
+    segmented += segments[s].size();
+  }
+  result.counts.push_back({"segmented", segmented});
+  result.timings.push_back({"segmentation", SecondsSince(t0)});
+
+  // 4. Cylinders per segment, in parallel; per-segment seeds make the result thread-count free.
+  t0 = Clock::now();
+  std::vector<std::vector<FittedCylinder>> per_segment(segments.size());
+  std::exception_ptr failure;
+  const int n_segments = static_cast<int>(segments.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ThreadCount(params.threads))
+  for (int s = 0; s < n_segments; ++s) {
+    try {
+      per_segment[s] = FitCylinders(cloud, segments[s], static_cast<std::uint32_t>(s), params.cylinders,
+                                    MixSeed(input.seed, 1000 + static_cast<std::uint64_t>(s)), stop);
+    } catch (...) {
+#pragma omp critical
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  std::vector<Cylinder> cylinders;
+  std::vector<const std::vector<std::uint32_t>*> inliers_of;
+  std::uint64_t fitted = 0;
+  for (const auto& fits : per_segment) {
+    for (const FittedCylinder& f : fits) {
+      cylinders.push_back(f.cylinder);
+      inliers_of.push_back(&f.inliers);
+      fitted += f.inliers.size();
+    }
+  }
+  result.cylinder_count = static_cast<std::uint32_t>(cylinders.size());
+  result.counts.push_back({"cylinder_inliers", fitted});
+  result.timings.push_back({"cylinders", SecondsSince(t0)});
+  ThrowIfStopped(stop, "cylinders");
+
+  // 5. Tube joining, with the visibility range image of the filtered cloud.
+  t0 = Clock::now();
+  std::optional<RangeImage> visibility;
+  if (params.joining.visibility_check && !cloud.points.empty()) {
+    visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
+  }
+  result.tubes = JoinTubes(cylinders, params.joining, visibility ? &*visibility : nullptr, stop);
+  result.timings.push_back({"joining", SecondsSince(t0)});
+
+  // Which tube took each filtered point: match output cylinders to fitted ones by their centre
+  // (joining may reverse a cylinder, which leaves its centre bit-identical).
+  result.tube_of_point.assign(cloud.size(), -1);
+  std::map<std::tuple<double, double, double, std::uint32_t>, std::size_t> fitted_by_centre;
+  for (std::size_t k = 0; k < cylinders.size(); ++k) {
+    const Eigen::Vector3d c = cylinders[k].centre();
+    fitted_by_centre.emplace(std::make_tuple(c.x(), c.y(), c.z(), cylinders[k].segment_id), k);
+  }
+  for (const Tube& tube : result.tubes) {
+    for (const Cylinder& cyl : tube.cylinders) {
+      const Eigen::Vector3d c = cyl.centre();
+      const auto it = fitted_by_centre.find(std::make_tuple(c.x(), c.y(), c.z(), cyl.segment_id));
+      if (it == fitted_by_centre.end()) continue;
+      for (std::uint32_t i : *inliers_of[it->second])
+        result.tube_of_point[i] = static_cast<std::int32_t>(tube.id);
+    }
+  }
+
+  result.total_seconds = SecondsSince(t_start);
+  spdlog::debug("modeled {} tubes from {} points ({} filtered, {} segments, {} cylinders) in {:.3f} s",
+                result.tubes.size(), result.input_points, cloud.size(), result.segment_count,
+                result.cylinder_count, result.total_seconds);
+  return result;
+}
+
+void DumpStages(const ModelingResult& result, const std::string& directory) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) throw InvalidArgument("dump-stages: cannot create '" + directory + "': " + ec.message());
+  const std::filesystem::path dir(directory);
+  const Points& points = result.filtered.points;
+  WritePly((dir / "1_filtered.ply").string(), points);
+
+  std::vector<Rgb> colours(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) colours[i] = LabelColour(result.segment_of_point[i]);
+  WritePly((dir / "2_segments.ply").string(), points, &colours);
+
+  Points tube_points;
+  std::vector<Rgb> tube_colours;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (result.tube_of_point[i] < 0) continue;
+    tube_points.push_back(points[i]);
+    tube_colours.push_back(LabelColour(result.tube_of_point[i]));
+  }
+  WritePly((dir / "3_tubes.ply").string(), tube_points, &tube_colours);
+}
+
+}  // namespace tubepick

@@ -1,0 +1,151 @@
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/common/stop_token.h"
+#include "core/common/types.h"
+
+namespace tubepick::internal {
+
+/// A (squared distance, point index) pair. "The k nearest" are the k smallest such pairs, so
+/// ties in distance are broken by index and every query has one answer.
+using Neighbour = std::pair<float, std::uint32_t>;
+
+/// A uniform hash grid over a point set for fixed-radius and k-nearest-neighbour queries.
+/// Cheaper than a kd-tree for the dense, surface-like clouds of a scanner: a query scans the few
+/// cells around the query point, whose points are contiguous in memory. Non-finite points are
+/// left out. Immutable after construction, so concurrent queries are safe.
+class NeighbourGrid {
+ public:
+  /// @pre cell_size > 0. The cell size is only a performance knob (ideally about the query
+  /// radius, or the expected distance to the k-th neighbour); results never depend on it.
+  NeighbourGrid(const Points& points, float cell_size);
+
+  float cell_size() const { return cell_size_; }
+  /// Number of (finite) points in the grid.
+  std::size_t size() const { return sorted_index_.size(); }
+
+  /// The k nearest points to q within max_radius (distance <= max_radius; infinity for no
+  /// limit), nearest first, ties by index. A point at q itself is included. Replaces *out.
+  void Nearest(const Eigen::Vector3f& q, std::size_t k, float max_radius, std::vector<Neighbour>* out) const;
+
+  /// Visits the points in cell order (original indices): querying in this order keeps the
+  /// touched cells in cache.
+  const std::vector<std::uint32_t>& cell_order() const { return sorted_index_; }
+
+  /// The points of the 3×3×3 cells around one cell, contiguous (structure of arrays). Every grid
+  /// point closer than Bound(q) to a query q of the centre cell is in the block.
+  struct Block {
+    std::vector<float> x, y, z;
+    std::vector<std::uint32_t> index;
+    /// Occupied cell c holds the points [cell_begin[c], cell_begin[c + 1]); its box is
+    /// [cell_lo[c], cell_lo[c] + cell size].
+    std::vector<std::uint32_t> cell_begin;
+    std::vector<Eigen::Vector3f> cell_lo;
+    /// The block's box.
+    Eigen::Vector3f lo = Eigen::Vector3f::Zero(), hi = Eigen::Vector3f::Zero();
+
+    std::size_t size() const { return index.size(); }
+    /// Distance from q (inside the box) to the box's boundary; 0 outside.
+    float Bound(const Eigen::Vector3f& q) const {
+      const float b = std::min((q - lo).minCoeff(), (hi - q).minCoeff());
+      return b > 0.0f ? b : 0.0f;
+    }
+  };
+
+  /// Calls visit(block, begin, end, state) for groups of queries sharing a grid cell, with that
+  /// cell's block, so that the block is gathered once per group. [begin, end) holds indices into
+  /// `queries`. Groups run in parallel (OpenMP); `state` is a default-constructed State per
+  /// thread. Stops early (leaving queries unvisited) once `stop` says so: the caller then calls
+  /// ThrowIfStopped.
+  template <typename State, typename Visit>
+  void ForEachQueryBlock(const Points& queries, const StopToken* stop, Visit&& visit) const;
+
+  /// Memory reused between NearestInBlock() calls of one thread, and a squared search radius
+  /// guessed from the previous (nearby) query.
+  struct NearestScratch {
+    std::vector<float> d2;
+    std::vector<Neighbour> candidates, spill;
+    float guess2 = 0.0f;
+  };
+
+  /// The same set as Nearest(), found in `block` (q's block) when it provably holds it, by the
+  /// ring search otherwise. The order is deterministic but not by distance.
+  void NearestInBlock(const Block& block, const Eigen::Vector3f& q, std::size_t k, float max_radius,
+                      NearestScratch* scratch, std::vector<Neighbour>* out) const;
+
+  /// Median, over a deterministic subsample of the grid's points, of the distance to their k-th
+  /// nearest point (the point itself counted), capped at max_radius. 0 for an empty grid.
+  float MedianNearestDistance(std::size_t k, float max_radius) const;
+
+  /// A cell size that makes k-nearest queries on `points` cheap (about the median distance to the
+  /// k-th neighbour, estimated on a provisional grid). Positive whenever `points` is non-empty.
+  static float SuggestCellSizeForNearest(const Points& points, std::size_t k);
+
+ private:
+  struct Cell {
+    std::uint64_t key;
+    std::uint32_t begin;
+    std::uint32_t end;
+  };
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+
+  using GroupVisit =
+      std::function<void(int thread, const Block&, const std::uint32_t*, const std::uint32_t*)>;
+  /// The OpenMP loop behind ForEachQueryBlock(); `thread` is in [0, MaxThreads()).
+  void ForEachGroup(const Points& queries, const StopToken* stop, const GroupVisit& visit) const;
+  static int MaxThreads();
+
+  struct QueryGroups {
+    /// Query indices, grouped.
+    std::vector<std::uint32_t> order;
+    /// Group g is order[begin[g], begin[g + 1]).
+    std::vector<std::uint32_t> begin;
+  };
+  /// Groups queries by their (occupied) grid cell; queries elsewhere get a group each.
+  QueryGroups GroupQueries(const Points& queries) const;
+  /// Fills `block` for the cell containing q (which may be outside the grid).
+  void GatherBlock(const Eigen::Vector3f& q, Block* block) const;
+
+  Eigen::Vector3i CellOf(const Eigen::Vector3f& p) const;
+  /// The cell containing p without clamping to the grid (bounded to avoid overflow).
+  Eigen::Vector3i UnclampedCellOf(const Eigen::Vector3f& p) const;
+  static std::uint64_t Key(int x, int y, int z) {
+    return (static_cast<std::uint64_t>(x) << 42) | (static_cast<std::uint64_t>(y) << 21) |
+           static_cast<std::uint64_t>(z);
+  }
+  /// The cell's [begin, end) range in sorted_points_, or nullptr for an empty cell.
+  const Cell* Find(int x, int y, int z) const;
+
+  float cell_size_;
+  float inv_cell_size_;
+  Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
+  /// Number of cells along each axis (cell coordinates are in [0, dims)).
+  Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
+  std::vector<Eigen::Vector3f> sorted_points_;
+  std::vector<std::uint32_t> sorted_index_;
+  std::vector<Cell> table_;
+  std::size_t cell_count_ = 0;
+  std::uint64_t mask_ = 0;
+};
+
+template <typename State, typename Visit>
+void NeighbourGrid::ForEachQueryBlock(const Points& queries, const StopToken* stop, Visit&& visit) const {
+  // One State per thread, each on its own cache lines.
+  struct alignas(64) PaddedState {
+    State state{};
+  };
+  std::vector<PaddedState> states(static_cast<std::size_t>(MaxThreads()));
+  ForEachGroup(queries, stop,
+               [&](int thread, const Block& block, const std::uint32_t* begin, const std::uint32_t* end) {
+                 visit(block, begin, end, states[static_cast<std::size_t>(thread)].state);
+               });
+}
+
+}  // namespace tubepick::internal

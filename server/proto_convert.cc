@@ -1,0 +1,89 @@
+#include "server/proto_convert.h"
+
+#include <google/protobuf/util/json_util.h>
+
+#include "core/common/errors.h"
+
+namespace tubepick {
+
+void ToProto(const Eigen::Vector3d& v, v1::Vector3* out) {
+  out->set_x(v.x());
+  out->set_y(v.y());
+  out->set_z(v.z());
+}
+
+void ToProto(const Eigen::Isometry3d& X, v1::Pose* out) {
+  ToProto(Eigen::Vector3d(X.translation()), out->mutable_position());
+  const Eigen::Quaterniond q(X.linear());
+  out->mutable_orientation()->set_x(q.x());
+  out->mutable_orientation()->set_y(q.y());
+  out->mutable_orientation()->set_z(q.z());
+  out->mutable_orientation()->set_w(q.w());
+}
+
+v1::Occlusion ToProto(Occlusion occlusion) {
+  switch (occlusion) {
+    case Occlusion::kNone:
+      return v1::OCCLUSION_NONE;
+    case Occlusion::kWeak:
+      return v1::OCCLUSION_WEAK;
+    case Occlusion::kStrong:
+      return v1::OCCLUSION_STRONG;
+    case Occlusion::kUnspecified:
+      break;
+  }
+  return v1::OCCLUSION_UNSPECIFIED;
+}
+
+void ToProto(const Tube& tube, v1::Tube* out) {
+  out->set_id(tube.id);
+  for (const Cylinder& c : tube.cylinders) {
+    v1::Cylinder* pc = out->add_cylinders();
+    ToProto(c.start, pc->mutable_start());
+    ToProto(c.end, pc->mutable_end());
+    pc->set_radius(c.radius);
+    pc->set_segment_id(c.segment_id);
+    pc->set_inlier_count(c.inlier_count);
+  }
+  out->set_length(tube.length());
+  out->set_occlusion(ToProto(tube.occlusion));
+  out->set_occluded_joint_count(tube.occluded_joint_count);
+}
+
+v1::ModelTubesResponse ToModelTubesResponse(const ModelingResult& result, const std::string& profile,
+                                            std::uint64_t seed) {
+  v1::ModelTubesResponse response;
+  for (const Tube& t : result.tubes) ToProto(t, response.add_tubes());
+  response.set_max_height(result.max_height);
+  response.set_input_points(result.input_points);
+  response.set_dropped_non_finite(result.dropped_non_finite);
+  response.set_segment_count(result.segment_count);
+  response.set_cylinder_count(result.cylinder_count);
+  for (const StepCount& c : result.counts) {
+    v1::StepCount* pc = response.add_step_counts();
+    pc->set_step(c.step);
+    pc->set_points(c.points);
+  }
+  for (const StageTiming& t : result.timings) {
+    v1::StageTiming* pt = response.add_stage_timings();
+    pt->set_stage(t.stage);
+    pt->set_seconds(t.seconds);
+  }
+  response.set_total_seconds(result.total_seconds);
+  response.set_profile(profile);
+  response.set_seed(seed);
+  return response;
+}
+
+std::string ToJson(const google::protobuf::Message& message, bool pretty) {
+  google::protobuf::util::JsonPrintOptions options;
+  options.add_whitespace = pretty;
+  options.preserve_proto_field_names = false;
+  options.always_print_primitive_fields = true;
+  std::string json;
+  const auto status = google::protobuf::util::MessageToJsonString(message, &json, options);
+  if (!status.ok()) throw std::runtime_error("JSON conversion failed: " + std::string(status.message()));
+  return json;
+}
+
+}  // namespace tubepick

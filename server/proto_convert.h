@@ -1,0 +1,26 @@
+#pragma once
+
+#include <string>
+
+#include <google/protobuf/message.h>
+
+#include "core/modeling/model_tubes.h"
+#include "tubepick/v1/modeling.pb.h"
+
+namespace tubepick {
+
+/// core → wire conversions (the server owns the proto ↔ core mapping; the CLI reuses it so
+/// every consumer sees one schema).
+void ToProto(const Eigen::Vector3d& v, v1::Vector3* out);
+void ToProto(const Eigen::Isometry3d& X, v1::Pose* out);
+void ToProto(const Tube& tube, v1::Tube* out);
+v1::Occlusion ToProto(Occlusion occlusion);
+
+/// The response of ModelTubes for a modeling result.
+v1::ModelTubesResponse ToModelTubesResponse(const ModelingResult& result, const std::string& profile,
+                                            std::uint64_t seed);
+
+/// Proto3 JSON (field names as in the .proto, i.e. lowerCamelCase, enums by name).
+std::string ToJson(const google::protobuf::Message& message, bool pretty = true);
+
+}  // namespace tubepick

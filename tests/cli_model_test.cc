@@ -1,0 +1,117 @@
+// End-to-end: the `tubepick` binary on files, as an integrator would run it.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/modeling/cloud_io.h"
+#include "core/testing/synthetic_cloud.h"
+
+namespace tubepick {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+struct CliRun {
+  int exit_code;
+  std::string output;
+};
+
+CliRun RunCli(const std::string& args) {
+  const std::string cmd = std::string(TUBEPICK_CLI) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  return {WEXITSTATUS(status), out};
+}
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("tubepick_cli_test_" + name + "_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+nlohmann::json ReadJson(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+TEST(CliModel, ModelsAPlyFileAndWritesProtoJson) {
+  const fs::path dir = TempDir("ply");
+  const auto cloud = testing::RenderSyntheticCloud(
+      {testing::FloorTube({{-0.2, 0.0}, {0.2, 0.0}}),
+       testing::FloorTube({{0.0, -0.18}, {0.0, 0.18}}, 0.0125, 0.025)},
+      {});
+  WritePly((dir / "scene.ply").string(), cloud.points_Sensor);
+  const CliRun run = RunCli("model --cloud " + (dir / "scene.ply").string() + " --cell " + TUBEPICK_SOURCE_DIR +
+                         "/deploy/cell.example.yaml --seed 3 --json " + (dir / "out.json").string() +
+                         " --dump-stages " + (dir / "stages").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(dir / "out.json");
+  ASSERT_EQ(j["tubes"].size(), 2u) << run.output;
+  EXPECT_EQ(j["profile"], "fast");
+  EXPECT_EQ(j["seed"], "3");  // proto3 JSON writes uint64 as a string
+  EXPECT_EQ(j["tubes"][0]["occlusion"], "OCCLUSION_UNSPECIFIED");
+  EXPECT_GT(j["tubes"][0]["length"].get<double>(), 0.3);
+  EXPECT_EQ(j["stageTimings"].size(), 6u);
+  EXPECT_EQ(j["stepCounts"][0]["step"], "input");
+  EXPECT_TRUE(fs::exists(dir / "stages" / "2_segments.ply"));
+  EXPECT_TRUE(fs::exists(dir / "stages" / "3_tubes.ply"));
+  fs::remove_all(dir);
+}
+
+TEST(CliModel, MillimetrePcdGivesSameTubesAsMetrePly) {
+  const fs::path dir = TempDir("mm");
+  auto cloud = testing::RenderSyntheticCloud({testing::FloorTube({{-0.2, -0.05}, {0.0, 0.0}, {0.2, 0.05}})}, {});
+  WritePly((dir / "m.ply").string(), cloud.points_Sensor);
+  for (auto& p : cloud.points_Sensor) p *= 1000.0f;
+  WritePcd((dir / "mm.pcd").string(), cloud.points_Sensor, true);
+  ASSERT_EQ(RunCli("model --cloud " + (dir / "m.ply").string() + " --json " + (dir / "m.json").string()).exit_code, 0);
+  ASSERT_EQ(RunCli("model --cloud " + (dir / "mm.pcd").string() + " --unit mm --json " + (dir / "mm.json").string())
+                .exit_code,
+            0);
+  const auto a = ReadJson(dir / "m.json"), b = ReadJson(dir / "mm.json");
+  ASSERT_EQ(a["tubes"].size(), 1u);
+  ASSERT_EQ(b["tubes"].size(), 1u);
+  EXPECT_NEAR(a["tubes"][0]["length"].get<double>(), b["tubes"][0]["length"].get<double>(), 1e-3);
+  fs::remove_all(dir);
+}
+
+TEST(CliModel, BadInputsGiveClearErrors) {
+  const fs::path dir = TempDir("bad");
+  {
+    std::ofstream(dir / "junk.ply") << "this is not a cloud\n";
+  }
+  CliRun run = RunCli("model --cloud " + (dir / "junk.ply").string());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("junk.ply"));
+  {
+    std::ofstream(dir / "params.yaml") << "modeling:\n  cylinders:\n    min_radius: 0.5\n";
+  }
+  run = RunCli("params --params " + (dir / "params.yaml").string() + " --dump");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("modeling.cylinders.min_radius"));
+  run = RunCli("model --profile turbo");
+  EXPECT_NE(run.exit_code, 0);
+  fs::remove_all(dir);
+}
+
+TEST(CliParams, DumpsBothProfiles) {
+  CliRun fast = RunCli("params --profile fast --dump");
+  CliRun thesis = RunCli("params --profile thesis --dump");
+  ASSERT_EQ(fast.exit_code, 0);
+  ASSERT_EQ(thesis.exit_code, 0);
+  EXPECT_THAT(thesis.output, HasSubstr("statistical_outlier"));
+  EXPECT_THAT(thesis.output, HasSubstr("neighbours: 77"));
+  EXPECT_THAT(fast.output, HasSubstr("crop_box"));
+}
+
+}  // namespace
+}  // namespace tubepick
