@@ -6,6 +6,7 @@
 #include "clients/cli/bench_command.h"
 #include "clients/cli/model_command.h"
 #include "clients/cli/params_command.h"
+#include "clients/cli/plan_command.h"
 #include "core/common/errors.h"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   tubepick::cli::AddModelCommand(app);
   tubepick::cli::AddParamsCommand(app);
+  tubepick::cli::AddPlanCommand(app);
   tubepick::cli::AddBenchCommand(app);
   try {
     app.parse(argc, argv);

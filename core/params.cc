@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 #include <yaml-cpp/yaml.h>
 
 #include "core/common/errors.h"
 #include "core/common/yaml_reader.h"
+#include "core/params_sections.h"
 
 namespace tubepick {
 namespace {
@@ -175,7 +177,8 @@ void ReadModeling(YamlMap& m, ModelingParams& p) {
 // ---- writing ----------------------------------------------------------------------------------
 
 void EmitVector(YAML::Emitter& e, const char* key, const Eigen::Vector3d& v) {
-  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z() << YAML::EndSeq;
+  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z()
+    << YAML::EndSeq;
 }
 
 struct FilterWriter {
@@ -194,7 +197,9 @@ struct FilterWriter {
     e << YAML::Key << "min" << YAML::Value << p.min;
     e << YAML::Key << "max" << YAML::Value << p.max;
   }
-  void operator()(const VoxelGridParams& p) const { e << YAML::Key << "leaf_size" << YAML::Value << p.leaf_size; }
+  void operator()(const VoxelGridParams& p) const {
+    e << YAML::Key << "leaf_size" << YAML::Value << p.leaf_size;
+  }
   void operator()(const RandomSampleParams& p) const { e << YAML::Key << "count" << YAML::Value << p.count; }
   void operator()(const RadiusOutlierParams& p) const {
     e << YAML::Key << "radius" << YAML::Value << p.radius;
@@ -237,7 +242,8 @@ void EmitModeling(YAML::Emitter& e, const ModelingParams& p) {
   e << YAML::Key << "min_cluster_size" << YAML::Value << s.min_cluster_size;
   e << YAML::Key << "max_cluster_size" << YAML::Value << s.max_cluster_size;
   e << YAML::Key << "neighbours" << YAML::Value << s.neighbours;
-  e << YAML::Key << "smoothness_threshold" << YAML::Value << s.smoothness_threshold << YAML::Comment("radians");
+  e << YAML::Key << "smoothness_threshold" << YAML::Value << s.smoothness_threshold
+    << YAML::Comment("radians");
   e << YAML::Key << "curvature_threshold" << YAML::Value << s.curvature_threshold;
   e << YAML::Key << "residual_test" << YAML::Value << s.residual_test;
   e << YAML::Key << "residual_threshold" << YAML::Value << s.residual_threshold;
@@ -273,9 +279,72 @@ void EmitModeling(YAML::Emitter& e, const ModelingParams& p) {
   e << YAML::EndMap;
 }
 
+
+// ---- planning / wrench / placement: one field list (params_sections.h), two visitors ---------
+
+struct SectionReader {
+  YamlMap& m;
+  template <typename T>
+  void operator()(const char* key, T& value) {
+    m.Read(key, value);
+  }
+  template <typename T>
+  void Section(const char* key, T& section) {
+    YamlMap child(m.Child(key), m.PathOf(key));
+    SectionReader reader{child};
+    internal::DescribeFields(reader, section);
+    child.RejectUnknown();
+  }
+  template <typename E, typename ToText, typename FromText>
+  void Enum(const char* key, E& value, ToText to_text, FromText from_text) {
+    std::string text = to_text(value);
+    m.Read(key, text);
+    value = from_text(text, m.PathOf(key));
+  }
+};
+
+struct SectionWriter {
+  YAML::Emitter& e;
+  template <typename T>
+  void operator()(const char* key, T& value) {
+    if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+      EmitVector(e, key, value);
+    } else {
+      e << YAML::Key << key << YAML::Value << value;
+    }
+  }
+  template <typename T>
+  void Section(const char* key, T& section) {
+    e << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    internal::DescribeFields(*this, section);
+    e << YAML::EndMap;
+  }
+  template <typename E, typename ToText, typename FromText>
+  void Enum(const char* key, E& value, ToText to_text, FromText) {
+    e << YAML::Key << key << YAML::Value << to_text(value);
+  }
+};
+
+template <typename T>
+void ReadSection(YamlMap& top, const char* key, T& section) {
+  SectionReader reader{top};
+  reader.Section(key, section);
+}
+
+template <typename T>
+void WriteSection(YAML::Emitter& e, const char* key, T section) {
+  SectionWriter writer{e};
+  writer.Section(key, section);
+}
+
 }  // namespace
 
-void Params::Validate() const { modeling.Validate(); }
+void Params::Validate() const {
+  modeling.Validate();
+  planning.Validate();
+  wrench.Validate();
+  placement.Validate();
+}
 
 std::vector<std::string> ProfileNames() { return {"fast", "thesis"}; }
 
@@ -299,6 +368,9 @@ Params ParseParams(const std::string& yaml_text, const Params& base) {
     YamlMap m(top.Child("modeling"), "modeling");
     ReadModeling(m, p.modeling);
   }
+  ReadSection(top, "planning", p.planning);
+  ReadSection(top, "wrench", p.wrench);
+  ReadSection(top, "placement", p.placement);
   top.RejectUnknown();
   p.Validate();
   return p;
@@ -317,6 +389,9 @@ std::string DumpParams(const Params& params) {
   e.SetDoublePrecision(9);
   e << YAML::BeginMap << YAML::Key << "modeling" << YAML::Value;
   EmitModeling(e, params.modeling);
+  WriteSection(e, "planning", params.planning);
+  WriteSection(e, "wrench", params.wrench);
+  WriteSection(e, "placement", params.placement);
   e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }

@@ -4,6 +4,9 @@
 #include <vector>
 
 #include "core/modeling/modeling_params.h"
+#include "core/placement/placement.h"
+#include "core/planning/pick_planner.h"
+#include "core/wrench/wrench_params.h"
 
 namespace tubepick {
 
@@ -11,6 +14,9 @@ namespace tubepick {
 /// compiled-in default from the chosen profile.
 struct Params {
   ModelingParams modeling;
+  PlanningParams planning;
+  WrenchParams wrench;
+  PlacementParams placement;
 
   /// @throws InvalidArgument naming the first bad key.
   void Validate() const;

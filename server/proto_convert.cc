@@ -75,6 +75,50 @@ v1::ModelTubesResponse ToModelTubesResponse(const ModelingResult& result, const 
   return response;
 }
 
+v1::TrajectoryKind ToProto(TrajectoryKind kind) {
+  switch (kind) {
+    case TrajectoryKind::kUpward:
+      return v1::TRAJECTORY_KIND_UPWARD;
+    case TrajectoryKind::kEscape:
+      return v1::TRAJECTORY_KIND_ESCAPE;
+    case TrajectoryKind::kOcclusionEscape:
+      return v1::TRAJECTORY_KIND_OCCLUSION_ESCAPE;
+  }
+  return v1::TRAJECTORY_KIND_UNSPECIFIED;
+}
+
+v1::PlanPickResponse ToPlanPickResponse(const PickPlanResult& result, const ModelingResult& modeling,
+                                        const std::string& profile, std::uint64_t seed) {
+  v1::PlanPickResponse response;
+  for (const PickPlan& plan : result.plans) {
+    v1::PickPlan* p = response.add_plans();
+    p->set_tube_id(plan.tube_id);
+    ToProto(plan.grasp.X_BinTcp, p->mutable_grasp()->mutable_tcp_pose());
+    ToProto(plan.grasp.approach_Bin, p->mutable_grasp()->mutable_approach());
+    p->mutable_grasp()->set_opening_width(plan.grasp.opening_width);
+    for (const Eigen::Vector3d& w : plan.waypoints) ToProto(w, p->add_waypoints());
+    p->set_trajectory_kind(ToProto(plan.kind));
+    p->mutable_cost()->set_height(plan.costs.height);
+    p->mutable_cost()->set_centre(plan.costs.centre);
+    p->mutable_cost()->set_trajectory(plan.costs.trajectory);
+    p->mutable_cost()->set_total(plan.costs.total);
+    p->set_simulated_displacement(plan.displacement.value_or(0.0));
+    if (plan.X_BinTcp_place) ToProto(*plan.X_BinTcp_place, p->mutable_place_tcp_pose());
+  }
+  for (const Tube& t : result.tubes) ToProto(t, response.add_tubes());
+  response.set_bin_empty(result.bin_empty);
+  response.set_used_simulation(result.used_simulation);
+  *response.mutable_modeling() = ToModelTubesResponse(modeling, profile, seed);
+  response.mutable_modeling()->clear_tubes();  // the classified tubes above supersede them
+  for (const StageTiming& t : result.timings) {
+    v1::StageTiming* pt = response.add_stage_timings();
+    pt->set_stage(t.stage);
+    pt->set_seconds(t.seconds);
+  }
+  response.set_total_seconds(result.total_seconds);
+  return response;
+}
+
 std::string ToJson(const google::protobuf::Message& message, bool pretty) {
   google::protobuf::util::JsonPrintOptions options;
   options.add_whitespace = pretty;

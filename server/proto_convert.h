@@ -5,7 +5,9 @@
 #include <google/protobuf/message.h>
 
 #include "core/modeling/model_tubes.h"
+#include "core/planning/pick_planner.h"
 #include "tubepick/v1/modeling.pb.h"
+#include "tubepick/v1/planning.pb.h"
 
 namespace tubepick {
 
@@ -19,6 +21,12 @@ v1::Occlusion ToProto(Occlusion occlusion);
 /// The response of ModelTubes for a modeling result.
 v1::ModelTubesResponse ToModelTubesResponse(const ModelingResult& result, const std::string& profile,
                                             std::uint64_t seed);
+
+v1::TrajectoryKind ToProto(TrajectoryKind kind);
+
+/// The response of PlanPick: plans best first, classified tubes, the modeling summary.
+v1::PlanPickResponse ToPlanPickResponse(const PickPlanResult& plan, const ModelingResult& modeling,
+                                        const std::string& profile, std::uint64_t seed);
 
 /// Proto3 JSON (field names as in the .proto, i.e. lowerCamelCase, enums by name).
 std::string ToJson(const google::protobuf::Message& message, bool pretty = true);

@@ -33,7 +33,8 @@ CliRun RunCli(const std::string& args) {
 }
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("tubepick_cli_test_" + name + "_" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("tubepick_cli_test_" + name + "_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return dir;
 }
@@ -45,14 +46,14 @@ nlohmann::json ReadJson(const fs::path& p) {
 
 TEST(CliModel, ModelsAPlyFileAndWritesProtoJson) {
   const fs::path dir = TempDir("ply");
-  const auto cloud = testing::RenderSyntheticCloud(
-      {testing::FloorTube({{-0.2, 0.0}, {0.2, 0.0}}),
-       testing::FloorTube({{0.0, -0.18}, {0.0, 0.18}}, 0.0125, 0.025)},
-      {});
+  const auto cloud =
+      testing::RenderSyntheticCloud({testing::FloorTube({{-0.2, 0.0}, {0.2, 0.0}}),
+                                     testing::FloorTube({{0.0, -0.18}, {0.0, 0.18}}, 0.0125, 0.025)},
+                                    {});
   WritePly((dir / "scene.ply").string(), cloud.points_Sensor);
-  const CliRun run = RunCli("model --cloud " + (dir / "scene.ply").string() + " --cell " + TUBEPICK_SOURCE_DIR +
-                         "/deploy/cell.example.yaml --seed 3 --json " + (dir / "out.json").string() +
-                         " --dump-stages " + (dir / "stages").string());
+  const CliRun run = RunCli("model --cloud " + (dir / "scene.ply").string() + " --cell " +
+                            TUBEPICK_SOURCE_DIR + "/deploy/cell.example.yaml --seed 3 --json " +
+                            (dir / "out.json").string() + " --dump-stages " + (dir / "stages").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json j = ReadJson(dir / "out.json");
   ASSERT_EQ(j["tubes"].size(), 2u) << run.output;
@@ -69,14 +70,18 @@ TEST(CliModel, ModelsAPlyFileAndWritesProtoJson) {
 
 TEST(CliModel, MillimetrePcdGivesSameTubesAsMetrePly) {
   const fs::path dir = TempDir("mm");
-  auto cloud = testing::RenderSyntheticCloud({testing::FloorTube({{-0.2, -0.05}, {0.0, 0.0}, {0.2, 0.05}})}, {});
+  auto cloud =
+      testing::RenderSyntheticCloud({testing::FloorTube({{-0.2, -0.05}, {0.0, 0.0}, {0.2, 0.05}})}, {});
   WritePly((dir / "m.ply").string(), cloud.points_Sensor);
   for (auto& p : cloud.points_Sensor) p *= 1000.0f;
   WritePcd((dir / "mm.pcd").string(), cloud.points_Sensor, true);
-  ASSERT_EQ(RunCli("model --cloud " + (dir / "m.ply").string() + " --json " + (dir / "m.json").string()).exit_code, 0);
-  ASSERT_EQ(RunCli("model --cloud " + (dir / "mm.pcd").string() + " --unit mm --json " + (dir / "mm.json").string())
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunCli("model --cloud " + (dir / "m.ply").string() + " --json " + (dir / "m.json").string()).exit_code,
+      0);
+  ASSERT_EQ(
+      RunCli("model --cloud " + (dir / "mm.pcd").string() + " --unit mm --json " + (dir / "mm.json").string())
+          .exit_code,
+      0);
   const auto a = ReadJson(dir / "m.json"), b = ReadJson(dir / "mm.json");
   ASSERT_EQ(a["tubes"].size(), 1u);
   ASSERT_EQ(b["tubes"].size(), 1u);
@@ -86,15 +91,11 @@ TEST(CliModel, MillimetrePcdGivesSameTubesAsMetrePly) {
 
 TEST(CliModel, BadInputsGiveClearErrors) {
   const fs::path dir = TempDir("bad");
-  {
-    std::ofstream(dir / "junk.ply") << "this is not a cloud\n";
-  }
+  { std::ofstream(dir / "junk.ply") << "this is not a cloud\n"; }
   CliRun run = RunCli("model --cloud " + (dir / "junk.ply").string());
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("junk.ply"));
-  {
-    std::ofstream(dir / "params.yaml") << "modeling:\n  cylinders:\n    min_radius: 0.5\n";
-  }
+  { std::ofstream(dir / "params.yaml") << "modeling:\n  cylinders:\n    min_radius: 0.5\n"; }
   run = RunCli("params --params " + (dir / "params.yaml").string() + " --dump");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("modeling.cylinders.min_radius"));

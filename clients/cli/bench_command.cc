@@ -104,7 +104,8 @@ void RunBench(const BenchOptions& o) {
   fmt::print("\n");
   for (const std::string& stage : figures.front().stage_order) {
     fmt::print("| {} |", stage);
-    for (const auto& f : figures) fmt::print(" {:.4f} |", f.stage_median.count(stage) ? f.stage_median.at(stage) : 0.0);
+    for (const auto& f : figures)
+      fmt::print(" {:.4f} |", f.stage_median.count(stage) ? f.stage_median.at(stage) : 0.0);
     fmt::print("\n");
   }
   fmt::print("| **total** |");

@@ -19,8 +19,9 @@ BuiltInScene MakeBuiltInScene(const CellConfig& cell, std::uint32_t tubes, std::
   out.points_Sensor = std::move(scan.points_Sensor);
   out.labels.assign(scan.labels.begin(), scan.labels.end());
   out.tube_count = tubes;
-  out.description = fmt::format("{} set-A tubes dropped into a {:.2f} x {:.2f} m bin (seed {}), scanned at 1920x1200",
-                                tubes, cell.bin.inner_size.x(), cell.bin.inner_size.y(), seed);
+  out.description =
+      fmt::format("{} set-A tubes dropped into a {:.2f} x {:.2f} m bin (seed {}), scanned at 1920x1200",
+                  tubes, cell.bin.inner_size.x(), cell.bin.inner_size.y(), seed);
   return out;
 }
 

@@ -11,7 +11,7 @@ namespace tubepick::cli {
 
 /// Options every planning command shares: cell, profile, params overrides, seed.
 struct CommonOptions {
-  std::string cell_path;    ///< empty = embedded default cell
+  std::string cell_path;  ///< empty = embedded default cell
   std::string profile = "fast";
   std::string params_path;  ///< empty = the profile as is
   std::uint64_t seed = 0;

@@ -24,9 +24,11 @@ struct ModelOptions {
 
 void PrintSummary(const ModelingResult& r, const std::string& source) {
   fmt::print("{}\n", source);
-  fmt::print("{} points ({} non-finite dropped) -> {} filtered -> {} segments -> {} cylinders -> {} tubes in {:.3f} s\n",
-             r.input_points, r.dropped_non_finite, r.filtered.size(), r.segment_count, r.cylinder_count,
-             r.tubes.size(), r.total_seconds);
+  fmt::print(
+      "{} points ({} non-finite dropped) -> {} filtered -> {} segments -> {} cylinders -> {} tubes in {:.3f} "
+      "s\n",
+      r.input_points, r.dropped_non_finite, r.filtered.size(), r.segment_count, r.cylinder_count,
+      r.tubes.size(), r.total_seconds);
   fmt::print("{:>5} {:>9} {:>9}  {:<30} {:<30}\n", "tube", "length_m", "cylinders", "end A (x, y, z) m",
              "end B (x, y, z) m");
   for (const Tube& t : r.tubes) {

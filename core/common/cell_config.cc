@@ -31,8 +31,8 @@ Eigen::Isometry3d ReadPose(YamlMap& parent, const std::string& key, const Eigen:
   map.RejectUnknown();
   const double norm = xyzw.norm();
   if (std::abs(norm - 1.0) > 1e-3) {
-    throw InvalidArgument(map.PathOf("orientation_xyzw") + ": quaternion must be unit length, |q| = " +
-                          std::to_string(norm));
+    throw InvalidArgument(map.PathOf("orientation_xyzw") +
+                          ": quaternion must be unit length, |q| = " + std::to_string(norm));
   }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = Eigen::Quaterniond(xyzw[3], xyzw[0], xyzw[1], xyzw[2]).normalized().toRotationMatrix();
@@ -66,8 +66,9 @@ void CellConfig::Validate() const {
   }
   if (!sensor.X_BinSensor.matrix().allFinite()) throw InvalidArgument("sensor.pose_in_bin: non-finite pose");
   if (sensor.X_BinSensor.translation().z() <= 0.0) {
-    throw InvalidArgument("sensor.pose_in_bin.position: the sensor must be above the bin floor (z > 0), got z = " +
-                          std::to_string(sensor.X_BinSensor.translation().z()));
+    throw InvalidArgument(
+        "sensor.pose_in_bin.position: the sensor must be above the bin floor (z > 0), got z = " +
+        std::to_string(sensor.X_BinSensor.translation().z()));
   }
   RequireInRange(tube.radius, 0.001, 0.2, "tube.radius");
   RequireInRange(tube.length, 0.0, 10.0, "tube.length");

@@ -117,7 +117,8 @@ void YamlMap::RejectUnknown() const {
 }
 
 void RequireFinite(double value, const std::string& key) {
-  if (!std::isfinite(value)) throw InvalidArgument(key + ": value must be finite, got " + std::to_string(value));
+  if (!std::isfinite(value))
+    throw InvalidArgument(key + ": value must be finite, got " + std::to_string(value));
 }
 
 void RequirePositive(double value, const std::string& key) {
@@ -143,8 +144,8 @@ YAML::Node ParseYaml(const std::string& text, const std::string& what) {
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InvalidArgument(what + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
-                          std::to_string(e.mark.column + 1) + ": " + e.msg);
+    throw InvalidArgument(what + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) +
+                          ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
 }
 

@@ -14,12 +14,6 @@ namespace {
 // Cell coordinates are packed into 21 bits per axis.
 constexpr int kMaxCellsPerAxis = (1 << 21) - 1;
 
-// Fibonacci hashing mixed down, so all three packed coordinates reach the low bits.
-std::uint64_t HashSlot(std::uint64_t key, std::uint64_t mask) {
-  const std::uint64_t h = key * 0x9E3779B97F4A7C15ULL;
-  return (h ^ (h >> 32)) & mask;
-}
-
 bool IsFinite(const Eigen::Vector3f& p) {
   return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z());
 }
@@ -83,6 +77,10 @@ NeighbourGrid::NeighbourGrid(const Points& points, float cell_size) : cell_size_
     inv_cell_size_ = 1.0f / cell_size_;
   }
   origin_ = lo;
+  hi_ = hi;
+  // A few float ulps (2^-24 relative) of the largest coordinate, for the rounding of cell
+  // assignments and of cell corners: ~10⁻⁶ m for a cloud within a metre of the origin.
+  slack_ = 3e-6f * lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff();
   for (int a = 0; a < 3; ++a) {
     dims_[a] = std::min(kMaxCellsPerAxis, static_cast<int>((hi[a] - lo[a]) * inv_cell_size_) + 1);
   }
@@ -91,6 +89,7 @@ NeighbourGrid::NeighbourGrid(const Points& points, float cell_size) : cell_size_
   std::uint64_t capacity = 64;
   table_.assign(capacity, Cell{kEmpty, 0, 0});
   mask_ = capacity - 1;
+  shift_ = 64 - 6;
   std::vector<std::uint32_t> cell_of(points.size(), 0);
   std::vector<std::uint32_t> count;
   std::vector<std::uint64_t> key_of_cell;
@@ -98,7 +97,7 @@ NeighbourGrid::NeighbourGrid(const Points& points, float cell_size) : cell_size_
     if (!IsFinite(points[i])) continue;
     const Eigen::Vector3i c = CellOf(points[i]);
     const std::uint64_t key = Key(c.x(), c.y(), c.z());
-    std::uint64_t slot = HashSlot(key, mask_);
+    std::uint64_t slot = HashSlot(key);
     while (table_[slot].key != kEmpty && table_[slot].key != key) slot = (slot + 1) & mask_;
     if (table_[slot].key == kEmpty) {
       table_[slot] = Cell{key, static_cast<std::uint32_t>(count.size()), 0};
@@ -107,15 +106,16 @@ NeighbourGrid::NeighbourGrid(const Points& points, float cell_size) : cell_size_
       if (2 * count.size() > capacity) {  // Grow: keep the load factor at most 1/2.
         capacity *= 4;
         mask_ = capacity - 1;
+        shift_ -= 2;
         std::vector<Cell> old = std::move(table_);
         table_.assign(capacity, Cell{kEmpty, 0, 0});
         for (const Cell& cell : old) {
           if (cell.key == kEmpty) continue;
-          std::uint64_t s = HashSlot(cell.key, mask_);
+          std::uint64_t s = HashSlot(cell.key);
           while (table_[s].key != kEmpty) s = (s + 1) & mask_;
           table_[s] = cell;
         }
-        slot = HashSlot(key, mask_);
+        slot = HashSlot(key);
         while (table_[slot].key != key) slot = (slot + 1) & mask_;
       }
     }
@@ -123,10 +123,11 @@ NeighbourGrid::NeighbourGrid(const Points& points, float cell_size) : cell_size_
     ++count[table_[slot].begin];
   }
 
-  cell_count_ = count.size();
   // Pass 2: cell ranges by prefix sums, then scatter the points.
   std::vector<std::uint32_t> begin(count.size() + 1, 0);
   for (std::size_t c = 0; c < count.size(); ++c) begin[c + 1] = begin[c] + count[c];
+  cells_.resize(count.size());
+  for (std::size_t c = 0; c < count.size(); ++c) cells_[c] = Cell{key_of_cell[c], begin[c], begin[c + 1]};
   for (Cell& cell : table_) {
     if (cell.key == kEmpty) continue;
     const std::uint32_t c = cell.begin;
@@ -278,7 +279,8 @@ void NeighbourGrid::NearestInBlock(const Block& block, const Eigen::Vector3f& q,
   const float* by = block.y.data();
   const float* bz = block.z.data();
   const float limit2 = max_radius * max_radius;
-  const float bound = block.Bound(q);
+  const float slack = Slack(q);
+  const float bound = SafeBound(block.Bound(q), slack);
   const float bound2 = bound * bound;
 
   // Squared distances of the points [begin, end) (vectorised), then those within threshold2
@@ -311,21 +313,21 @@ void NeighbourGrid::NearestInBlock(const Block& block, const Eigen::Vector3f& q,
   // Try the radius guessed from the previous query, then the largest radius the block answers
   // for (the distance to its boundary, or max_radius if smaller). Only cells within the radius
   // are scanned. Exact when k points are found nearer than anything outside the block, or when
-  // the block holds all of max_radius.
+  // the block holds all of max_radius. Bounds and cell distances allow for rounding (Slack()).
   const float safe2 = std::min(bound2, limit2);
   auto attempt = [&](float threshold2) {
     const float size = cell_size_;
     std::size_t m = 0;
     for (std::size_t c = 0; c + 1 < block.cell_begin.size(); ++c) {
       const Eigen::Vector3f& lo = block.cell_lo[c];
-      const float ex = std::max({lo.x() - qx, qx - lo.x() - size, 0.0f});
-      const float ey = std::max({lo.y() - qy, qy - lo.y() - size, 0.0f});
-      const float ez = std::max({lo.z() - qz, qz - lo.z() - size, 0.0f});
-      if (ex * ex + ey * ey + ez * ez > threshold2) continue;
+      const float ex = std::max({lo.x() - qx - slack, qx - lo.x() - size - slack, 0.0f});
+      const float ey = std::max({lo.y() - qy - slack, qy - lo.y() - size - slack, 0.0f});
+      const float ez = std::max({lo.z() - qz - slack, qz - lo.z() - size - slack, 0.0f});
+      if ((ex * ex + ey * ey + ez * ez) * (1.0f - 2e-6f) > threshold2) continue;
       m = scan(block.cell_begin[c], block.cell_begin[c + 1], threshold2, m);
     }
     const float kth = select(m, threshold2);
-    if ((m >= k && kth < bound2) || (threshold2 >= limit2 && limit2 <= bound2)) {
+    if ((m >= k && kth < bound2) || (threshold2 >= limit2 && bound > 0.0f && limit2 <= bound2)) {
       if (out->size() == k) scratch->guess2 = 1.3f * kth;
       return true;
     }
@@ -340,7 +342,7 @@ void NeighbourGrid::NearestInBlock(const Block& block, const Eigen::Vector3f& q,
 
 const NeighbourGrid::Cell* NeighbourGrid::Find(int x, int y, int z) const {
   const std::uint64_t key = Key(x, y, z);
-  std::uint64_t slot = HashSlot(key, mask_);
+  std::uint64_t slot = HashSlot(key);
   while (true) {
     const Cell& cell = table_[slot];
     if (cell.key == key) return &cell;
@@ -354,15 +356,14 @@ void NeighbourGrid::Nearest(const Eigen::Vector3f& q, std::size_t k, float max_r
   out->clear();
   if (k == 0 || sorted_points_.empty() || !IsFinite(q)) return;
   const float max_r2 = max_radius * max_radius;  // infinity stays infinity
-  const Eigen::Vector3i c = UnclampedCellOf(q);  // q may lie outside the grid's box
-  // Rings closer than the grid's box hold no cells.
-  int ring = 0;
-  for (int a = 0; a < 3; ++a) ring = std::max({ring, -c[a], c[a] - (dims_[a] - 1)});
+  const float slack = Slack(q);
+  // Nothing within max_radius if q is farther than that from the points' bounding box.
+  const Eigen::Vector3f gap = (origin_ - q).cwiseMax(q - hi_).cwiseMax(0.0f);
+  const float gap_bound = SafeBound(gap.norm(), slack);
+  if (gap_bound > 0.0f && gap_bound >= max_radius) return;
 
-  auto scan_cell = [&](int x, int y, int z) {
-    const Cell* cell = Find(x, y, z);
-    if (cell == nullptr) return;
-    for (std::uint32_t i = cell->begin; i < cell->end; ++i) {
+  auto scan = [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
       const float dx = sorted_points_[i].x() - q.x(), dy = sorted_points_[i].y() - q.y();
       const float dz = sorted_points_[i].z() - q.z();
       const float d2 = dx * dx + dy * dy + dz * dz;  // the same rounding as NearestInBlock()
@@ -370,29 +371,34 @@ void NeighbourGrid::Nearest(const Eigen::Vector3f& q, std::size_t k, float max_r
     }
   };
 
-  // Cells looked up so far; past a few times the number of occupied cells (q far from the
-  // rest, e.g. an outlier), a scan of all points is cheaper than more rings.
+  const Eigen::Vector3i c = UnclampedCellOf(q);  // q may lie outside the grid's box
+  // Rings closer than the grid's box hold no cells.
+  int ring = 0;
+  for (int a = 0; a < 3; ++a) ring = std::max({ring, -c[a], c[a] - (dims_[a] - 1)});
+  // Lookups (mostly of empty cells once rings grow) are capped at about what a visit of every
+  // occupied cell costs: a query in a large empty region (an outlier, a query far from the grid)
+  // then visits the occupied cells instead, so it costs O(cells + points) at worst.
+  const std::uint64_t lookup_budget = std::min(cells_.size() / 8, sorted_points_.size() / 4) + 64;
   std::uint64_t looked_up = 0;
-  const std::uint64_t exhaustive_after = 4 * static_cast<std::uint64_t>(cell_count_) + 64;
+  std::uint64_t box_cells = 0;  // cells of the previous ring's box, clipped to the grid
   for (;; ++ring) {
-    // Scan the shell of cells at Chebyshev distance `ring` from c, clipped to the grid.
+    // The shell of cells at Chebyshev distance `ring` from c, clipped to the grid (never empty:
+    // the first ring reaches the grid, whose box is disjoint from the rings inside it).
     const int x0 = std::max(c.x() - ring, 0), x1 = std::min(c.x() + ring, dims_.x() - 1);
     const int y0 = std::max(c.y() - ring, 0), y1 = std::min(c.y() + ring, dims_.y() - 1);
     const int z0 = std::max(c.z() - ring, 0), z1 = std::min(c.z() + ring, dims_.z() - 1);
-    if (x0 <= x1 && y0 <= y1 && z0 <= z1) {
-      looked_up += static_cast<std::uint64_t>(x1 - x0 + 1) * static_cast<std::uint64_t>(y1 - y0 + 1) *
-                   static_cast<std::uint64_t>(z1 - z0 + 1);
-    }
-    if (looked_up > exhaustive_after) {
-      out->clear();
-      for (std::size_t i = 0; i < sorted_points_.size(); ++i) {
-        const float dx = sorted_points_[i].x() - q.x(), dy = sorted_points_[i].y() - q.y();
-        const float dz = sorted_points_[i].z() - q.z();
-        const float d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 <= max_r2) out->emplace_back(d2, sorted_index_[i]);
-      }
+    const std::uint64_t cells = static_cast<std::uint64_t>(x1 - x0 + 1) *
+                                static_cast<std::uint64_t>(y1 - y0 + 1) *
+                                static_cast<std::uint64_t>(z1 - z0 + 1);
+    looked_up += cells - box_cells;  // the shell
+    box_cells = cells;
+    if (looked_up > lookup_budget) {
+      NearestInRemainingCells(q, c, ring, k, max_r2, slack, out);
       break;
     }
+    auto scan_cell = [&](int x, int y, int z) {
+      if (const Cell* cell = Find(x, y, z)) scan(cell->begin, cell->end);
+    };
     for (int x = x0; x <= x1; ++x) {
       const bool x_face = std::abs(x - c.x()) == ring;
       for (int y = y0; y <= y1; ++y) {
@@ -404,7 +410,7 @@ void NeighbourGrid::Nearest(const Eigen::Vector3f& q, std::size_t k, float max_r
         }
       }
     }
-    // Every point not scanned yet is at least `bound` away from q.
+    // Every point not scanned yet is farther than `bound` from q.
     float bound = std::numeric_limits<float>::max();
     bool covers_grid = true;
     for (int a = 0; a < 3; ++a) {
@@ -413,12 +419,14 @@ void NeighbourGrid::Nearest(const Eigen::Vector3f& q, std::size_t k, float max_r
       bound = std::min({bound, q[a] - lo, hi - q[a]});
       covers_grid = covers_grid && c[a] - ring <= 0 && c[a] + ring >= dims_[a] - 1;
     }
-    if (covers_grid || bound >= max_radius) break;
+    bound = SafeBound(bound, slack);
+    if (covers_grid || (bound > 0.0f && bound >= max_radius)) break;
     if (out->size() >= k) {
-      const float b2 = bound * bound;
-      std::size_t certain = 0;
-      for (const Neighbour& n : *out) certain += n.first < b2;
-      if (certain >= k) break;
+      // Only the k smallest can be the answer: drop the others (so a ring costs O(k + its
+      // points) here), and stop once the k-th is nearer than anything not scanned.
+      std::nth_element(out->begin(), out->begin() + static_cast<std::ptrdiff_t>(k - 1), out->end());
+      out->resize(k);
+      if (out->back().first < bound * bound) break;
     }
   }
   if (out->size() > k) {
@@ -426,6 +434,46 @@ void NeighbourGrid::Nearest(const Eigen::Vector3f& q, std::size_t k, float max_r
     out->resize(k);
   }
   std::sort(out->begin(), out->end());
+}
+
+void NeighbourGrid::NearestInRemainingCells(const Eigen::Vector3f& q, const Eigen::Vector3i& c, int ring,
+                                            std::size_t k, float max_r2, float slack,
+                                            std::vector<Neighbour>* out) const {
+  // The k best so far, as a max-heap on (squared distance, index).
+  if (out->size() > k) {
+    std::nth_element(out->begin(), out->begin() + static_cast<std::ptrdiff_t>(k - 1), out->end());
+    out->resize(k);
+  }
+  std::make_heap(out->begin(), out->end());
+  constexpr std::uint64_t kAxis = kMaxCellsPerAxis;  // the 21 bits of one coordinate in a Key()
+  for (const Cell& cell : cells_) {
+    const Eigen::Vector3i xyz(static_cast<int>(cell.key >> 42), static_cast<int>((cell.key >> 21) & kAxis),
+                              static_cast<int>(cell.key & kAxis));
+    if ((xyz - c).cwiseAbs().maxCoeff() < ring) continue;  // scanned by the rings
+    // Skip the cell if all its points are farther than the k-th so far, or than max_radius.
+    const float limit2 = out->size() == k ? std::min(out->front().first, max_r2) : max_r2;
+    float gap2 = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+      const float lo = origin_[a] + static_cast<float>(xyz[a]) * cell_size_;
+      const float gap = std::max({lo - q[a] - slack, q[a] - lo - cell_size_ - slack, 0.0f});
+      gap2 += gap * gap;
+    }
+    if (gap2 * (1.0f - 2e-6f) > limit2) continue;
+    for (std::uint32_t i = cell.begin; i < cell.end; ++i) {
+      const float dx = sorted_points_[i].x() - q.x(), dy = sorted_points_[i].y() - q.y();
+      const float dz = sorted_points_[i].z() - q.z();
+      const Neighbour candidate(dx * dx + dy * dy + dz * dz, sorted_index_[i]);
+      if (candidate.first > max_r2) continue;
+      if (out->size() < k) {
+        out->push_back(candidate);
+        std::push_heap(out->begin(), out->end());
+      } else if (candidate < out->front()) {
+        std::pop_heap(out->begin(), out->end());
+        out->back() = candidate;
+        std::push_heap(out->begin(), out->end());
+      }
+    }
+  }
 }
 
 float NeighbourGrid::MedianNearestDistance(std::size_t k, float max_radius) const {

@@ -33,6 +33,8 @@ class NeighbourGrid {
 
   /// The k nearest points to q within max_radius (distance <= max_radius; infinity for no
   /// limit), nearest first, ties by index. A point at q itself is included. Replaces *out.
+  /// Scans rings of cells around q; a query far from the points (an outlier, a sparse cloud)
+  /// visits the occupied cells instead, so a query costs O(cells + points) at worst.
   void Nearest(const Eigen::Vector3f& q, std::size_t k, float max_radius, std::vector<Neighbour>* out) const;
 
   /// Visits the points in cell order (original indices): querying in this order keeps the
@@ -40,7 +42,8 @@ class NeighbourGrid {
   const std::vector<std::uint32_t>& cell_order() const { return sorted_index_; }
 
   /// The points of the 3×3×3 cells around one cell, contiguous (structure of arrays). Every grid
-  /// point closer than Bound(q) to a query q of the centre cell is in the block.
+  /// point closer than Bound(q) to a query q of the centre cell is in the block (up to rounding,
+  /// which NearestInBlock() allows for).
   struct Block {
     std::vector<float> x, y, z;
     std::vector<std::uint32_t> index;
@@ -122,17 +125,41 @@ class NeighbourGrid {
   }
   /// The cell's [begin, end) range in sorted_points_, or nullptr for an empty cell.
   const Cell* Find(int x, int y, int z) const;
+  /// Nearest()'s search once rings get too costly: merges the points within max_r2 of the
+  /// occupied cells outside the rings already scanned (Chebyshev distance < ring from c) into
+  /// *out, keeping the k smallest, and skipping cells too far to hold any of them.
+  void NearestInRemainingCells(const Eigen::Vector3f& q, const Eigen::Vector3i& c, int ring, std::size_t k,
+                               float max_r2, float slack, std::vector<Neighbour>* out) const;
+  /// Home slot of a key: Fibonacci hashing, the top bits of key × 2^64/φ, to which every bit
+  /// of the key contributes (the low bits of the product ignore the high bits of the key, i.e.
+  /// x, so cells along x would share a slot and probe long clusters).
+  std::uint64_t HashSlot(std::uint64_t key) const { return (key * 0x9E3779B97F4A7C15ULL) >> shift_; }
+  /// How far, at most, rounding can put a grid point on the wrong side of a cell face computed
+  /// near q (cell assignment, cell corners): a few float ulps of the coordinates involved.
+  float Slack(const Eigen::Vector3f& q) const { return slack_ + 1e-6f * q.cwiseAbs().maxCoeff(); }
+  /// A bound, safe against rounding, on the distance from q to the points outside a box whose
+  /// faces are at least `bound` from q as computed: if it is positive, every such point has a
+  /// squared distance (as computed) greater than its square, and than max_radius² if it is at
+  /// least max_radius. `slack` is Slack(q).
+  static float SafeBound(float bound, float slack) { return std::max(bound * (1.0f - 1e-6f) - slack, 0.0f); }
 
   float cell_size_;
   float inv_cell_size_;
+  /// The points' bounding box is [origin_, hi_].
   Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
+  Eigen::Vector3f hi_ = Eigen::Vector3f::Zero();
+  /// Slack() for a query near the grid.
+  float slack_ = 0.0f;
   /// Number of cells along each axis (cell coordinates are in [0, dims)).
   Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
   std::vector<Eigen::Vector3f> sorted_points_;
   std::vector<std::uint32_t> sorted_index_;
   std::vector<Cell> table_;
-  std::size_t cell_count_ = 0;
+  /// The occupied cells in the order of their points.
+  std::vector<Cell> cells_;
+  /// A non-empty grid's table_ has mask_ + 1 = 2^(64 - shift_) slots.
   std::uint64_t mask_ = 0;
+  int shift_ = 63;
 };
 
 template <typename State, typename Visit>

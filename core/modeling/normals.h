@@ -23,8 +23,7 @@ struct NormalParams {
 /// neighbours get NaN normal and curvature (the caller drops them). Parallel with OpenMP;
 /// the result does not depend on the thread count.
 /// @throws InvalidArgument for radius <= 0.
-OrientedPoints EstimateNormals(const Points& query_Bin, const Points& surface_Bin,
-                               const NormalParams& params, const Eigen::Vector3f& viewpoint_Bin,
-                               const StopToken* stop = nullptr);
+OrientedPoints EstimateNormals(const Points& query_Bin, const Points& surface_Bin, const NormalParams& params,
+                               const Eigen::Vector3f& viewpoint_Bin, const StopToken* stop = nullptr);
 
 }  // namespace tubepick

@@ -58,8 +58,8 @@ struct JoinDistance {
 /// angle between `a_out` and b − a, β between `b_out` and a − b; the angular term is 0 when the
 /// euclidean distance is below `shortcut_radius` (or 0).
 JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a_out,
-                              const Eigen::Vector3d& b, const Eigen::Vector3d& b_out,
-                              double shortcut_radius, const JoiningParams& params);
+                              const Eigen::Vector3d& b, const Eigen::Vector3d& b_out, double shortcut_radius,
+                              const JoiningParams& params);
 
 /// Joins cylinders into tubes. Every cylinder starts as its own tube; compatible endpoint pairs
 /// of different tubes are united (different tubes, distance and angle limits, length constraint,

@@ -38,7 +38,8 @@ SyntheticTube FloorTube(const std::vector<Eigen::Vector2d>& xy, double radius, d
   return tube;
 }
 
-SyntheticCloud RenderSyntheticCloud(const std::vector<SyntheticTube>& tubes, const SyntheticCloudParams& params) {
+SyntheticCloud RenderSyntheticCloud(const std::vector<SyntheticTube>& tubes,
+                                    const SyntheticCloudParams& params) {
   const Eigen::Isometry3d X_SensorBin = params.X_BinSensor.inverse();
   const int width = static_cast<int>(std::ceil(2.0 * params.half_fov_x / params.pixel_angle));
   const int height = static_cast<int>(std::ceil(2.0 * params.half_fov_y / params.pixel_angle));
@@ -72,16 +73,19 @@ SyntheticCloud RenderSyntheticCloud(const std::vector<SyntheticTube>& tubes, con
     if (lo.z() <= 1e-6) continue;
     double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
     for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d q((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+      const Eigen::Vector3d q((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                              (c & 4) ? hi.z() : lo.z());
       umin = std::min(umin, q.x() / q.z());
       umax = std::max(umax, q.x() / q.z());
       vmin = std::min(vmin, q.y() / q.z());
       vmax = std::max(vmax, q.y() / q.z());
     }
     const int i0 = std::max(0, static_cast<int>(std::floor((umin + params.half_fov_x) / params.pixel_angle)));
-    const int i1 = std::min(width - 1, static_cast<int>(std::ceil((umax + params.half_fov_x) / params.pixel_angle)));
+    const int i1 =
+        std::min(width - 1, static_cast<int>(std::ceil((umax + params.half_fov_x) / params.pixel_angle)));
     const int j0 = std::max(0, static_cast<int>(std::floor((vmin + params.half_fov_y) / params.pixel_angle)));
-    const int j1 = std::min(height - 1, static_cast<int>(std::ceil((vmax + params.half_fov_y) / params.pixel_angle)));
+    const int j1 =
+        std::min(height - 1, static_cast<int>(std::ceil((vmax + params.half_fov_y) / params.pixel_angle)));
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const Eigen::Vector3d d = pixel_direction(i, j);
@@ -106,7 +110,8 @@ SyntheticCloud RenderSyntheticCloud(const std::vector<SyntheticTube>& tubes, con
         const double t = RayPlane(origin, d, n, c);
         if (!std::isfinite(t)) continue;
         const Eigen::Vector3d p_Bin = params.X_BinSensor * (t * d);
-        if (std::abs(p_Bin.x()) > 0.5 * params.floor_size.x() || std::abs(p_Bin.y()) > 0.5 * params.floor_size.y()) {
+        if (std::abs(p_Bin.x()) > 0.5 * params.floor_size.x() ||
+            std::abs(p_Bin.y()) > 0.5 * params.floor_size.y()) {
           continue;
         }
         const std::size_t idx = static_cast<std::size_t>(j) * width + i;

@@ -58,7 +58,8 @@ TEST(CellConfig, RejectsOutOfRangeRadius) {
 }
 
 TEST(CellConfig, RejectsNonUnitQuaternionAndUnknownUnit) {
-  EXPECT_THROW(ParseCellConfig("sensor:\n  pose_in_bin:\n    orientation_xyzw: [1, 1, 0, 0]\n"), InvalidArgument);
+  EXPECT_THROW(ParseCellConfig("sensor:\n  pose_in_bin:\n    orientation_xyzw: [1, 1, 0, 0]\n"),
+               InvalidArgument);
   try {
     ParseCellConfig("sensor:\n  unit: inch\n");
     FAIL();

@@ -24,8 +24,10 @@ std::vector<std::uint32_t> BruteForce(const Points& points, const Eigen::Vector3
     const float d2 = dx * dx + dy * dy + dz * dz;
     if (d2 <= max_radius * max_radius) all.emplace_back(d2, i);
   }
-  std::sort(all.begin(), all.end());
-  if (all.size() > k) all.resize(k);
+  if (all.size() > k) {
+    std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end());
+    all.resize(k);
+  }
   std::vector<std::uint32_t> indices;
   for (const Neighbour& n : all) indices.push_back(n.second);
   std::sort(indices.begin(), indices.end());
@@ -55,6 +57,34 @@ Points MakeCloud(int kind, std::mt19937_64& rng) {
   return points;
 }
 
+// Both search paths (NearestInBlock() over the query blocks, and Nearest()) against brute force.
+void ExpectMatchesBruteForce(const Points& points, const NeighbourGrid& grid, const Points& queries,
+                             std::size_t k, float max_radius) {
+  std::vector<std::vector<std::uint32_t>> in_block(queries.size());
+  struct State {
+    NeighbourGrid::NearestScratch scratch;
+    std::vector<Neighbour> out;
+  };
+  grid.ForEachQueryBlock<State>(queries, nullptr,
+                                [&](const NeighbourGrid::Block& block, const std::uint32_t* begin,
+                                    const std::uint32_t* end, State& state) {
+                                  for (const std::uint32_t* it = begin; it != end; ++it) {
+                                    grid.NearestInBlock(block, queries[*it], k, max_radius, &state.scratch,
+                                                        &state.out);
+                                    in_block[*it] = Indices(state.out);
+                                  }
+                                });
+  std::vector<Neighbour> ring;
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    SCOPED_TRACE(testing::Message() << "k " << k << " max_radius " << max_radius << " query " << q);
+    const std::vector<std::uint32_t> expected = BruteForce(points, queries[q], k, max_radius);
+    ASSERT_EQ(in_block[q], expected);
+    grid.Nearest(queries[q], k, max_radius, &ring);
+    ASSERT_EQ(Indices(ring), expected);
+    ASSERT_TRUE(std::is_sorted(ring.begin(), ring.end())) << "Nearest() returns nearest first";
+  }
+}
+
 TEST(NeighbourGrid, NearestMatchesBruteForce) {
   std::mt19937_64 rng(7);
   for (int kind = 0; kind < 4; ++kind) {
@@ -62,35 +92,57 @@ TEST(NeighbourGrid, NearestMatchesBruteForce) {
     for (const float cell : {0.001f, 0.01f}) {
       const NeighbourGrid grid(points, cell);
       EXPECT_EQ(grid.size(), points.size() - 1);  // the NaN point is left out
+      Points queries(points.begin(), points.end() - 1);
+      queries.push_back(Eigen::Vector3f(0.3f, 2.0f, -0.1f));  // outside the grid
       for (const std::size_t k : {1u, 7u, 30u}) {
         for (const float max_radius : {0.006f, kInf}) {
-          Points queries(points.begin(), points.end() - 1);
-          queries.push_back(Eigen::Vector3f(0.3f, 2.0f, -0.1f));  // outside the grid
-          std::vector<std::vector<std::uint32_t>> in_block(queries.size());
-          struct State {
-            NeighbourGrid::NearestScratch scratch;
-            std::vector<Neighbour> out;
-          };
-          grid.ForEachQueryBlock<State>(queries, nullptr,
-                                        [&](const NeighbourGrid::Block& block, const std::uint32_t* begin,
-                                            const std::uint32_t* end, State& state) {
-                                          for (const std::uint32_t* it = begin; it != end; ++it) {
-                                            grid.NearestInBlock(block, queries[*it], k, max_radius,
-                                                                &state.scratch, &state.out);
-                                            in_block[*it] = Indices(state.out);
-                                          }
-                                        });
-          std::vector<Neighbour> ring;
-          for (std::size_t q = 0; q < queries.size(); ++q) {
-            SCOPED_TRACE(testing::Message() << "kind " << kind << " cell " << cell << " k " << k
-                                            << " max_radius " << max_radius << " query " << q);
-            const std::vector<std::uint32_t> expected = BruteForce(points, queries[q], k, max_radius);
-            ASSERT_EQ(in_block[q], expected);
-            grid.Nearest(queries[q], k, max_radius, &ring);
-            ASSERT_EQ(Indices(ring), expected);
-            ASSERT_TRUE(std::is_sorted(ring.begin(), ring.end())) << "Nearest() returns nearest first";
-          }
+          SCOPED_TRACE(testing::Message() << "kind " << kind << " cell " << cell);
+          ASSERT_NO_FATAL_FAILURE(ExpectMatchesBruteForce(points, grid, queries, k, max_radius));
         }
+      }
+    }
+  }
+}
+
+// Points in cells of a millimetre, about 0.2 m apart, and queries far from all of them: the
+// searches must not walk the empty cells in between (~10⁹ in the grid's box alone).
+TEST(NeighbourGrid, FarQueryOnSparseCloud) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  Points points(100);
+  for (Eigen::Vector3f& p : points) p = Eigen::Vector3f(u(rng), u(rng), u(rng));
+  const NeighbourGrid grid(points, 0.001f);
+  Points queries = points;
+  queries.emplace_back(0.0f, 0.0f, 0.0f);        // inside the grid's box, among empty cells
+  queries.emplace_back(0.3f, 2.0f, -0.1f);       // outside it
+  queries.emplace_back(1e6f, -1e6f, 1e6f);       // far beyond the cell coordinates' range
+  for (const std::size_t k : {1u, 30u, 200u}) {  // 200: more than there are points
+    for (const float max_radius : {0.2f, kInf}) {
+      ASSERT_NO_FATAL_FAILURE(ExpectMatchesBruteForce(points, grid, queries, k, max_radius));
+    }
+  }
+}
+
+// Points on cell faces (multiples of the cell size, or an ulp off) and a radius of one cell:
+// many distances equal the radius, or the distance to a ring's or a block's boundary, up to
+// rounding. The searches' bounds must allow for that rounding.
+TEST(NeighbourGrid, ExactOnCellFaces) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> lattice(0, 7), nudge(-1, 1);
+  constexpr float kCell = 0.003f;
+  for (int trial = 0; trial < 8; ++trial) {
+    Points points(200);
+    for (Eigen::Vector3f& p : points) {
+      for (int a = 0; a < 3; ++a) {
+        p[a] = static_cast<float>(lattice(rng)) * kCell;
+        if (const int n = nudge(rng); n != 0) p[a] = std::nextafter(p[a], static_cast<float>(n));
+      }
+    }
+    const NeighbourGrid grid(points, kCell);
+    for (const std::size_t k : {5u, 20u}) {
+      for (const float max_radius : {kCell, kInf}) {
+        SCOPED_TRACE(testing::Message() << "trial " << trial);
+        ASSERT_NO_FATAL_FAILURE(ExpectMatchesBruteForce(points, grid, points, k, max_radius));
       }
     }
   }

@@ -87,5 +87,21 @@ TEST(Params, OutOfRangeValuesNameTheKey) {
   EXPECT_THAT(ErrorOf("modeling:\n  filters:\n    - random_sample: {count: 0}\n"), HasSubstr("count"));
 }
 
+TEST(Params, PlanningWrenchAndPlacementSectionsAreStrict) {
+  const Params p = ParseParams(
+      "planning:\n  trajectories:\n    upward_distance: 0.3\n  cost:\n    max_displacement: 0.5\n"
+      "wrench:\n  variant: joint_safe\n  rotation_angle: 1.0\nplacement:\n  yaw_only: false\n",
+      ProfileParams("fast"));
+  EXPECT_DOUBLE_EQ(p.planning.trajectories.upward_distance, 0.3);
+  EXPECT_DOUBLE_EQ(p.planning.cost.max_displacement, 0.5);
+  EXPECT_EQ(p.wrench.variant, ResolutionVariant::kJointSafe);
+  EXPECT_DOUBLE_EQ(p.wrench.rotation_angle, 1.0);
+  EXPECT_FALSE(p.placement.yaw_only);
+  EXPECT_THAT(ErrorOf("planning:\n  grasps:\n    spacng: 0.01\n"), HasSubstr("planning.grasps.spacng"));
+  EXPECT_THAT(ErrorOf("wrench:\n  variant: shake\n"), HasSubstr("wrench.variant"));
+  EXPECT_THAT(ErrorOf("planning:\n  grasps:\n    spacing: 0\n"), HasSubstr("planning.grasps.spacing"));
+  EXPECT_THAT(ErrorOf("planning:\n  cost:\n    height_weight: 0.9\n"), HasSubstr("weight"));
+}
+
 }  // namespace
 }  // namespace tubepick

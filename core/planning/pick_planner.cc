@@ -1,0 +1,290 @@
+#include "core/planning/pick_planner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "core/common/errors.h"
+#include "core/common/yaml_reader.h"
+
+namespace tubepick {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void RequireFiniteVector(const Eigen::Vector3d& v, const std::string& key) {
+  for (int k = 0; k < 3; ++k) RequireFinite(v[k], key + "[" + std::to_string(k) + "]");
+}
+
+// max_z of Eq. 5.4.
+double MaxHeight(const ModelingResult& modeling, const std::vector<Tube>& tubes) {
+  if (modeling.max_height > 0.0) return modeling.max_height;
+  double top = 0.0;
+  for (const Tube& tube : tubes) {
+    for (const Cylinder& c : tube.cylinders)
+      top = std::max({top, c.start.z() + c.radius, c.end.z() + c.radius});
+  }
+  return top;
+}
+
+// Grasps of one tube, synthesized once, with the finger test cached (it does not depend on the
+// trajectory): -1 unknown, 0 clear, 1 collides.
+struct TubeGrasps {
+  bool synthesized = false;
+  std::vector<Grasp> grasps;
+  std::vector<std::int8_t> collides;
+};
+
+struct Candidate {
+  std::uint32_t trajectory = 0;  // index into the stage's trajectories
+  std::uint32_t grasp = 0;       // index into TubeGrasps::grasps of the trajectory's tube
+};
+
+class StageTimer {
+ public:
+  explicit StageTimer(std::vector<StageTiming>* timings) : timings_(timings) {}
+  void Add(const std::string& stage, Clock::time_point start) {
+    const double seconds = SecondsSince(start);
+    for (StageTiming& t : *timings_) {
+      if (t.stage == stage) {
+        t.seconds += seconds;
+        return;
+      }
+    }
+    timings_->push_back(StageTiming{stage, seconds});
+  }
+
+ private:
+  std::vector<StageTiming>* timings_;
+};
+
+}  // namespace
+
+void PlanningParams::Validate() const {
+  RequireNonNegative(classification.length_tolerance, "planning.classification.length_tolerance");
+
+  const TrajectoryParams& t = trajectories;
+  RequirePositive(t.upward_distance, "planning.trajectories.upward_distance");
+  RequireNonNegative(t.escape_first_lift, "planning.trajectories.escape_first_lift");
+  RequirePositive(t.escape_second_lift, "planning.trajectories.escape_second_lift");
+  RequireNonNegative(t.escape_constant, "planning.trajectories.escape_constant");
+  RequireNonNegative(t.safety_margin, "planning.trajectories.safety_margin");
+  RequireNonNegative(t.min_escape_distance, "planning.trajectories.min_escape_distance");
+
+  const GraspParams& g = grasps;
+  RequirePositive(g.spacing, "planning.grasps.spacing");
+  RequireNonNegative(g.min_base_distance, "planning.grasps.min_base_distance");
+  RequirePositive(g.opening_width, "planning.grasps.opening_width");
+  RequireInRange(g.max_axis_inclination, 0.0, M_PI / 2.0, "planning.grasps.max_axis_inclination");
+
+  const GraspFilterParams& f = filters;
+  RequirePositive(f.finger_thickness, "planning.filters.finger_thickness");
+  RequirePositive(f.finger_width, "planning.filters.finger_width");
+  RequirePositive(f.finger_length, "planning.filters.finger_length");
+  RequireFinite(f.finger_tip_depth, "planning.filters.finger_tip_depth");
+  RequirePositive(f.grid_cell_size, "planning.filters.grid_cell_size");
+  RequireFiniteVector(f.workspace_min, "planning.filters.workspace_min");
+  RequireFiniteVector(f.workspace_max, "planning.filters.workspace_max");
+  for (int k = 0; k < 3; ++k) {
+    if (f.workspace_min[k] > f.workspace_max[k]) {
+      std::ostringstream s;
+      s << "planning.filters.workspace_min[" << k << "]: " << f.workspace_min[k] << " exceeds workspace_max["
+        << k << "] " << f.workspace_max[k];
+      throw InvalidArgument(s.str());
+    }
+  }
+
+  RequireNonNegative(cost.height_weight, "planning.cost.height_weight");
+  RequireNonNegative(cost.centre_weight, "planning.cost.centre_weight");
+  RequireNonNegative(cost.trajectory_weight, "planning.cost.trajectory_weight");
+  const double sum = cost.height_weight + cost.centre_weight + cost.trajectory_weight;
+  if (std::abs(sum - 1.0) > 1e-6) {
+    std::ostringstream s;
+    s << "planning.cost: height_weight + centre_weight + trajectory_weight must be 1, got "
+      << cost.height_weight << " + " << cost.centre_weight << " + " << cost.trajectory_weight << " = " << sum;
+    throw InvalidArgument(s.str());
+  }
+  RequirePositive(cost.max_displacement, "planning.cost.max_displacement");
+  RequireFinite(empty_min_height, "planning.empty_min_height");
+}
+
+bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params) {
+  if (!modeling.tubes.empty()) return false;
+  std::uint32_t above = 0;
+  for (const Eigen::Vector3f& p : modeling.filtered.points) {
+    if (p.z() > params.empty_min_height && ++above > params.empty_max_points) return false;
+  }
+  return true;
+}
+
+PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, const PlanningParams& params,
+                        TrajectoryEvaluator* evaluator, std::uint64_t seed, const StopToken* stop) {
+  const Clock::time_point start = Clock::now();
+  params.Validate();
+  cell.Validate();
+  if (!(params.grasps.opening_width > 2.0 * cell.tube.radius)) {
+    std::ostringstream s;
+    s << "planning.grasps.opening_width: " << params.grasps.opening_width
+      << " must exceed the tube diameter 2 * tube.radius = " << 2.0 * cell.tube.radius;
+    throw InvalidArgument(s.str());
+  }
+
+  PickPlanResult result;
+  StageTimer timer(&result.timings);
+  ThrowIfStopped(stop, "planning");
+
+  // 1. Classification.
+  Clock::time_point t0 = Clock::now();
+  ClassificationResult classified = ClassifyTubes(modeling.tubes, cell.tube.length, params.classification);
+  result.tubes = std::move(classified.tubes);
+  result.classes = std::move(classified.classes);
+  result.bin_empty = IsBinEmpty(modeling, params);
+  PlanningCounts& counts = result.counts;
+  counts.tubes = static_cast<std::uint32_t>(result.tubes.size());
+  for (const TubeClass& cls : result.classes) {
+    if (cls.too_short) {
+      ++counts.too_short;
+    } else if (cls.occlusion == Occlusion::kNone) {
+      ++counts.non_occluded;
+    } else if (cls.occlusion == Occlusion::kWeak) {
+      ++counts.weakly_occluded;
+    } else {
+      ++counts.strongly_occluded;
+    }
+  }
+  timer.Add("classification", t0);
+  if (counts.too_short == counts.tubes) {
+    result.total_seconds = SecondsSince(start);
+    return result;
+  }
+
+  const double max_z = MaxHeight(modeling, result.tubes);
+  const SafetyZone zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
+  std::unique_ptr<RawCloudIndex> raw;  // built on first use
+  std::vector<TubeGrasps> tube_grasps(result.tubes.size());
+
+  std::vector<Occlusion> stages = {Occlusion::kNone, Occlusion::kWeak};
+  if (params.strongly_occluded_candidates) stages.push_back(Occlusion::kStrong);
+  for (const Occlusion stage : stages) {
+    ThrowIfStopped(stop, "planning");
+    // 2. Trajectories of this stage's candidate tubes.
+    t0 = Clock::now();
+    std::vector<Trajectory> trajectories;
+    for (std::size_t t = 0; t < result.tubes.size(); ++t) {
+      const TubeClass& cls = result.classes[t];
+      if (cls.too_short || cls.occlusion != stage) continue;
+      std::vector<Trajectory> own = SynthesizeTrajectories(static_cast<std::uint32_t>(t), result.tubes[t],
+                                                           cls, cell.tube.radius, zone, params.trajectories);
+      trajectories.insert(trajectories.end(), own.begin(), own.end());
+    }
+    counts.trajectories += static_cast<std::uint32_t>(trajectories.size());
+    timer.Add("trajectories", t0);
+    if (trajectories.empty()) continue;
+
+    // 3. Grasps and filters.
+    if (!raw) {
+      t0 = Clock::now();
+      const auto [z_lo, z_hi] = FingerBandZ(result.tubes, params.filters);
+      raw = std::make_unique<RawCloudIndex>(modeling.raw_Bin, params.filters.grid_cell_size, z_lo, z_hi);
+      timer.Add("cloud_index", t0);
+    }
+    t0 = Clock::now();
+    std::vector<Candidate> viable;
+    std::vector<bool> trajectory_viable(trajectories.size(), false);
+    for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
+      ThrowIfStopped(stop, "grasp planning");
+      const Trajectory& trajectory = trajectories[ti];
+      TubeGrasps& tg = tube_grasps[trajectory.tube_index];
+      if (!tg.synthesized) {
+        tg.grasps = SynthesizeGrasps(result.tubes[trajectory.tube_index], params.grasps);
+        tg.collides.assign(tg.grasps.size(), -1);
+        tg.synthesized = true;
+      }
+      for (std::size_t gi = 0; gi < tg.grasps.size(); ++gi) {
+        const Grasp& grasp = tg.grasps[gi];
+        ++counts.grasp_candidates;
+        if (!InAllowedSection(grasp, trajectory)) {
+          ++counts.rejected_section;
+          continue;
+        }
+        if (!InsideWorkspace(grasp, trajectory, params.filters)) {
+          ++counts.rejected_workspace;
+          continue;
+        }
+        if (tg.collides[gi] < 0) tg.collides[gi] = FingersCollide(grasp, *raw, params.filters) ? 1 : 0;
+        if (tg.collides[gi] > 0) {
+          ++counts.rejected_fingers;
+          continue;
+        }
+        viable.push_back(Candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi)});
+        trajectory_viable[ti] = true;
+      }
+    }
+    timer.Add("grasps", t0);
+    if (viable.empty()) continue;
+
+    // Simulation of the trajectories that have a viable grasp (never for non-occluded tubes).
+    std::vector<std::optional<double>> displacement(trajectories.size());
+    if (stage != Occlusion::kNone && evaluator != nullptr) {
+      t0 = Clock::now();
+      std::vector<Trajectory> to_simulate;
+      std::vector<std::size_t> simulated_index;
+      for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
+        if (!trajectory_viable[ti]) continue;
+        to_simulate.push_back(trajectories[ti]);
+        simulated_index.push_back(ti);
+      }
+      const std::vector<TrajectoryOutcome> outcomes =
+          evaluator->Evaluate(result.tubes, to_simulate, seed, stop);
+      if (outcomes.size() != to_simulate.size()) {
+        throw std::logic_error("TrajectoryEvaluator returned " + std::to_string(outcomes.size()) +
+                               " outcomes for " + std::to_string(to_simulate.size()) + " trajectories");
+      }
+      for (std::size_t k = 0; k < outcomes.size(); ++k)
+        displacement[simulated_index[k]] = outcomes[k].displacement;
+      result.used_simulation = true;
+      counts.simulated_trajectories += static_cast<std::uint32_t>(to_simulate.size());
+      timer.Add("simulation", t0);
+    }
+
+    // 4. Costs and ranking.
+    t0 = Clock::now();
+    result.plans.reserve(viable.size());
+    for (const Candidate& c : viable) {
+      const Trajectory& trajectory = trajectories[c.trajectory];
+      const Tube& tube = result.tubes[trajectory.tube_index];
+      const Grasp& grasp = tube_grasps[trajectory.tube_index].grasps[c.grasp];
+      PickPlan plan;
+      plan.tube_id = tube.id;
+      plan.grasp = grasp;
+      plan.waypoints = trajectory.waypoints;
+      plan.kind = trajectory.kind;
+      plan.escape_direction = trajectory.escape_direction;
+      plan.trajectory_index = c.trajectory;
+      plan.displacement = displacement[c.trajectory];
+      plan.costs = PlanCost(grasp.p_Bin_grasp.z(), max_z, grasp.curve_position, tube.length(),
+                            plan.displacement, params.cost);
+      result.plans.push_back(std::move(plan));
+    }
+    RankPlans(&result.plans);
+    if (params.max_plans > 0 && result.plans.size() > params.max_plans) result.plans.resize(params.max_plans);
+    result.planned_class = stage;
+    timer.Add("ranking", t0);
+    break;
+  }
+  counts.plans = static_cast<std::uint32_t>(result.plans.size());
+  result.total_seconds = SecondsSince(start);
+  return result;
+}
+
+}  // namespace tubepick
