@@ -279,7 +279,6 @@ void EmitModeling(YAML::Emitter& e, const ModelingParams& p) {
   e << YAML::EndMap;
 }
 
-
 // ---- planning / wrench / placement: one field list (params_sections.h), two visitors ---------
 
 struct SectionReader {

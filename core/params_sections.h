@@ -73,17 +73,22 @@ void DescribeFields(Visit& v, WrenchParams& p) {
   v("max_tilt", p.max_tilt);
   v("rotation_angle", p.rotation_angle);
   v("min_torque", p.min_torque);
-  v.Enum("variant", p.variant, [](ResolutionVariant x) { return ToString(x); }, ParseResolutionVariant);
+  v.Enum(
+      "variant", p.variant, [](ResolutionVariant x) { return ToString(x); }, ParseResolutionVariant);
   v("joint_safe_axis", p.joint_safe_axis);
-  v.Enum("joint_safe_frame", p.joint_safe_frame, [](JointSafeFrame x) { return ToString(x); }, ParseJointSafeFrame);
+  v.Enum(
+      "joint_safe_frame", p.joint_safe_frame, [](JointSafeFrame x) { return ToString(x); },
+      ParseJointSafeFrame);
   v("joint_safe_min_yaw", p.joint_safe_min_yaw);
 }
 
 template <typename Visit>
 void DescribeFields(Visit& v, PlacementParams& p) {
   v("yaw_only", p.yaw_only);
-  v.Enum("origin", p.origin, [](TubeFrameOrigin x) { return ToString(x); }, ParseTubeFrameOrigin);
-  v.Enum("sign", p.sign, [](AxisSign x) { return ToString(x); }, ParseAxisSign);
+  v.Enum(
+      "origin", p.origin, [](TubeFrameOrigin x) { return ToString(x); }, ParseTubeFrameOrigin);
+  v.Enum(
+      "sign", p.sign, [](AxisSign x) { return ToString(x); }, ParseAxisSign);
   v("min_horizontal", p.min_horizontal);
   v("allow_flip", p.allow_flip);
 }

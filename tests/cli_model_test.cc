@@ -104,6 +104,23 @@ TEST(CliModel, BadInputsGiveClearErrors) {
   fs::remove_all(dir);
 }
 
+TEST(CliPlan, PlansTheBuiltInSceneAndWritesPlanPickResponse) {
+  const fs::path dir = TempDir("plan");
+  const CliRun run = RunCli("plan --tubes 4 --seed 2 --json " + (dir / "plan.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json j = ReadJson(dir / "plan.json");
+  ASSERT_GE(j["plans"].size(), 1u) << run.output;
+  EXPECT_FALSE(j["binEmpty"].get<bool>());
+  EXPECT_GE(j["tubes"].size(), 3u);
+  EXPECT_NE(j["tubes"][0]["occlusion"], "OCCLUSION_UNSPECIFIED");
+  const auto& best = j["plans"][0];
+  EXPECT_EQ(best["waypoints"][0]["z"].get<double>(), 0.0);
+  EXPECT_LE(best["cost"]["total"].get<double>(), 1.0);
+  EXPECT_TRUE(best.contains("placeTcpPose"));
+  EXPECT_EQ(best["grasp"]["approach"]["z"].get<double>(), -1.0);
+  fs::remove_all(dir);
+}
+
 TEST(CliParams, DumpsBothProfiles) {
   CliRun fast = RunCli("params --profile fast --dump");
   CliRun thesis = RunCli("params --profile thesis --dump");

@@ -13,6 +13,10 @@
 #include "clients/cli/cli_inputs.h"
 #include "core/modeling/cloud_io.h"
 #include "core/modeling/model_tubes.h"
+#include "core/planning/classification.h"
+#include "core/planning/pick_planner.h"
+#include "core/planning/trajectory_synthesis.h"
+#include "physics/trajectory_simulator.h"
 
 namespace tubepick::cli {
 namespace {
@@ -123,6 +127,93 @@ void RunBench(const BenchOptions& o) {
   }
 }
 
+template <typename F>
+double MedianSeconds(std::uint32_t repetitions, F&& run) {
+  run();  // warm-up
+  std::vector<double> samples;
+  for (std::uint32_t i = 0; i < repetitions; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    run();
+    samples.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return Median(samples);
+}
+
+struct PlanBenchOptions {
+  CommonOptions common;
+  std::uint32_t tubes = 10;
+  std::uint32_t repetitions = 5;
+  std::uint32_t trajectories = 15;
+};
+
+// The whole plan without simulation (modeling + planning), and the simulation a plan needs when
+// every tube is occluded: `trajectories` candidates of the scene's tubes evaluated in Bullet.
+void RunPlanBench(const PlanBenchOptions& o) {
+  const CellConfig cell = LoadCell(o.common);
+  const Params params = LoadParamsFor(o.common);
+  BuiltInScene scene = MakeBuiltInScene(cell, o.tubes, o.common.seed);
+  ModelingInput input;
+  input.points_Sensor = &scene.points_Sensor;
+  input.X_BinSensor = cell.sensor.X_BinSensor;
+  input.bin = cell.bin;
+  input.seed = o.common.seed;
+  fmt::print("bench plan: {} ({} points), profile {}, {} repetitions after 1 warm-up\n", scene.description,
+             scene.points_Sensor.size(), o.common.profile, o.repetitions);
+
+  ModelingResult modeling;
+  const double t_model = MedianSeconds(o.repetitions, [&] { modeling = ModelTubes(input, params.modeling); });
+  PickPlanResult plan;
+  const double t_plan = MedianSeconds(
+      o.repetitions, [&] { plan = PlanPick(modeling, cell, params.planning, nullptr, o.common.seed); });
+
+  // Candidate trajectories as the planner synthesises them, for every tube (occluded or not).
+  const ClassificationResult classes =
+      ClassifyTubes(modeling.tubes, cell.tube.length, params.planning.classification);
+  const SafetyZone zone = MakeSafetyZone(cell.bin, params.planning.trajectories.safety_margin);
+  std::vector<Trajectory> candidates;
+  for (std::uint32_t i = 0; i < classes.tubes.size(); ++i) {
+    for (Trajectory& t : SynthesizeTrajectories(i, classes.tubes[i], classes.classes[i], cell.tube.radius,
+                                                zone, params.planning.trajectories)) {
+      candidates.push_back(std::move(t));
+    }
+  }
+  // Escapes first (they are what simulation is for), then upward lifts.
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Trajectory& a, const Trajectory& b) {
+    return (a.kind != TrajectoryKind::kUpward) > (b.kind != TrajectoryKind::kUpward);
+  });
+  if (candidates.size() > o.trajectories) candidates.resize(o.trajectories);
+
+  std::vector<double> sim_seconds;
+  double displacement_sum = 0.0;
+  for (int threads : {1, 2}) {
+    physics::TrajectorySimParams sim;
+    sim.bin = cell.bin;
+    sim.tube_mass = cell.tube.mass;
+    sim.disp_max = params.planning.cost.max_displacement;
+    sim.threads = threads;
+    physics::BulletTrajectoryEvaluator evaluator(sim);
+    std::vector<TrajectoryOutcome> outcomes;
+    sim_seconds.push_back(MedianSeconds(o.repetitions, [&] {
+      outcomes = evaluator.Evaluate(classes.tubes, candidates, o.common.seed, nullptr);
+    }));
+    displacement_sum = 0.0;
+    for (const auto& out : outcomes) displacement_sum += out.displacement;
+  }
+
+  fmt::print("\n| figure (median) | value |\n|---|---|\n");
+  fmt::print("| modeling | {:.4f} s |\n", t_model);
+  fmt::print("| planning without simulation ({} plans{}) | {:.4f} s |\n", plan.plans.size(),
+             plan.used_simulation ? ", simulated" : "", t_plan);
+  fmt::print("| whole plan without simulation (modeling + planning) | {:.4f} s = {:.1f} plans/s |\n",
+             t_model + t_plan, 1.0 / (t_model + t_plan));
+  fmt::print("| simulation of {} trajectories, 1 thread | {:.4f} s |\n", candidates.size(), sim_seconds[0]);
+  fmt::print("| simulation of {} trajectories, 2 threads | {:.4f} s |\n", candidates.size(), sim_seconds[1]);
+  fmt::print("| whole plan with simulation, 2 threads | {:.4f} s |\n", t_model + t_plan + sim_seconds[1]);
+  fmt::print(
+      "\n2-thread speed-up of the simulation: {:.2f}x; summed displacement of the candidates {:.3f} m\n",
+      sim_seconds[0] / std::max(1e-9, sim_seconds[1]), displacement_sum);
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App& app) {
@@ -141,6 +232,20 @@ void AddBenchCommand(CLI::App& app) {
   cmd->add_option("--profiles", o->profiles, "Profiles to compare; the first is the reference")
       ->capture_default_str();
   cmd->callback([o] { RunBench(*o); });
+
+  auto p = std::make_shared<PlanBenchOptions>();
+  CLI::App* plan = bench->add_subcommand("plan", "Whole plan with and without trajectory simulation");
+  plan->add_option("--cell", p->common.cell_path, "Cell YAML")->check(CLI::ExistingFile);
+  plan->add_option("--profile", p->common.profile, "Parameter profile")
+      ->check(CLI::IsMember({"fast", "thesis"}))
+      ->capture_default_str();
+  plan->add_option("--tubes", p->tubes, "Tubes in the built-in scene")->capture_default_str();
+  plan->add_option("--seed", p->common.seed, "Scene and planning seed")->capture_default_str();
+  plan->add_option("--repetitions", p->repetitions, "Timed runs")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  plan->add_option("--trajectories", p->trajectories, "Trajectories to simulate")->capture_default_str();
+  plan->callback([p] { RunPlanBench(*p); });
 }
 
 }  // namespace tubepick::cli

@@ -80,15 +80,17 @@ void Run(const PlanOptions& o) {
              modeling.tubes.size(), plan.total_seconds, plan.plans.size(),
              plan.used_simulation ? " (trajectories simulated)" : "", plan.bin_empty ? "; BIN EMPTY" : "");
   fmt::print("{:>5} {:>9} {:>9}\n", "tube", "length_m", "occlusion");
-  for (const Tube& t : plan.tubes) fmt::print("{:>5} {:>9.3f} {:>9}\n", t.id, t.length(), OcclusionName(t.occlusion));
+  for (const Tube& t : plan.tubes)
+    fmt::print("{:>5} {:>9.3f} {:>9}\n", t.id, t.length(), OcclusionName(t.occlusion));
   fmt::print("{:>4} {:>5} {:>17} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
              "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
   for (std::size_t i = 0; i < plan.plans.size() && i < o.show; ++i) {
     const PickPlan& p = plan.plans[i];
     const Eigen::Vector3d g = p.grasp.p_Bin_grasp;
-    fmt::print("{:>4} {:>5} {:>17} ({:+.3f}, {:+.3f}, {:+.3f}) {:>7.3f} {:>7.3f} {:>7.3f} {:>7.3f} {:>9}\n", i,
-               p.tube_id, ToString(p.kind), g.x(), g.y(), g.z(), p.costs.height, p.costs.centre,
-               p.costs.trajectory, p.costs.total, p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
+    fmt::print("{:>4} {:>5} {:>17} ({:+.3f}, {:+.3f}, {:+.3f}) {:>7.3f} {:>7.3f} {:>7.3f} {:>7.3f} {:>9}\n",
+               i, p.tube_id, ToString(p.kind), g.x(), g.y(), g.z(), p.costs.height, p.costs.centre,
+               p.costs.trajectory, p.costs.total,
+               p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
   }
   if (!o.json_path.empty()) {
     WriteTextFile(o.json_path, ToJson(ToPlanPickResponse(plan, modeling, o.common.profile, o.common.seed)));

@@ -29,7 +29,8 @@ void AttachPlacements(const ModelingResult& modeling, const Eigen::Isometry3d& X
       }
       it = frames.emplace(plan.tube_id, frame).first;
     }
-    if (it->second) plan.X_BinTcp_place = PlanPlacement(plan.grasp.X_BinTcp, *it->second, X_BinPlace, params).X_BinTcpPlace;
+    if (it->second)
+      plan.X_BinTcp_place = PlanPlacement(plan.grasp.X_BinTcp, *it->second, X_BinPlace, params).X_BinTcpPlace;
   }
 }
 
