@@ -1,12 +1,14 @@
 // tubepick: command-line front end of the planning library (model, params, bench, ...).
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "clients/cli/bench_command.h"
+#include "clients/cli/eval_command.h"
 #include "clients/cli/model_command.h"
 #include "clients/cli/params_command.h"
 #include "clients/cli/plan_command.h"
+#include "clients/cli/scene_command.h"
 #include "core/common/errors.h"
 
 int main(int argc, char** argv) {
@@ -19,6 +21,8 @@ int main(int argc, char** argv) {
   tubepick::cli::AddParamsCommand(app);
   tubepick::cli::AddPlanCommand(app);
   tubepick::cli::AddBenchCommand(app);
+  tubepick::cli::AddSceneCommand(app);
+  tubepick::cli::AddEvalCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

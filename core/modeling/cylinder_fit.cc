@@ -90,7 +90,11 @@ std::optional<CylinderModel> Ransac(const SoaCloud& soa, const CylinderFitParams
   const std::uint64_t max_skip = 10ull * params.max_iterations;
   std::optional<CylinderModel> best;
   Eigen::Index best_count = 0;
-  double needed = 1.0;  // iterations needed for `probability`, updated with each better model
+  // Iterations needed for `probability`, set from the first model with an inlier and updated with
+  // each better one. Unbounded (max_iterations) until then: starting at 1, as PCL does, ends the
+  // search after one model whenever the first valid sample has no inlier at all (likely with a
+  // strict normal term), which abandoned whole segments.
+  double needed = std::numeric_limits<double>::infinity();
   std::uint64_t iterations = 0, skipped = 0;
   while (static_cast<double>(iterations) < needed && iterations < params.max_iterations) {
     const std::uint64_t i1 = UniformBelow(rng, n);
@@ -123,6 +127,33 @@ Eigen::Vector3d Canonical(const Eigen::Vector3d& a) {
     if (std::abs(a[i]) > 1e-9) return a[i] > 0.0 ? a : Eigen::Vector3d(-a);
   }
   return a;
+}
+
+// Keeps only the largest run of inliers that is contiguous along the axis (no gap longer than
+// `max_gap` between consecutive inliers' axial positions); the other inliers become outliers
+// again. A cylinder then models one continuous piece of tube: without this, a model fitted after
+// an earlier cylinder's points were removed could take inliers on both sides of that hole and
+// span over it, overlapping the earlier cylinder (thesis §4.6.2), which the joining cannot undo.
+void KeepLargestContiguousRun(const SoaCloud& soa, const CylinderModel& model, double max_gap,
+                              Eigen::Array<bool, Eigen::Dynamic, 1>& is_inlier) {
+  const Eigen::Vector3d a = model.direction.normalized();
+  std::vector<std::pair<double, Eigen::Index>> along;
+  along.reserve(static_cast<std::size_t>(is_inlier.count()));
+  for (Eigen::Index i = 0; i < soa.size(); ++i) {
+    if (is_inlier[i]) along.emplace_back((soa.point(i) - model.point).dot(a), i);
+  }
+  if (along.size() < 2) return;
+  std::sort(along.begin(), along.end());
+  std::size_t best_begin = 0, best_end = 0, begin = 0;
+  for (std::size_t k = 1; k <= along.size(); ++k) {
+    if (k == along.size() || along[k].first - along[k - 1].first > max_gap) {
+      if (k - begin > best_end - best_begin) best_begin = begin, best_end = k;
+      begin = k;
+    }
+  }
+  if (best_end - best_begin == along.size()) return;
+  is_inlier.setConstant(false);
+  for (std::size_t k = best_begin; k < best_end; ++k) is_inlier[along[k].second] = true;
 }
 
 }  // namespace
@@ -162,7 +193,10 @@ std::vector<FittedCylinder> FitCylinders(const OrientedPoints& cloud, const Segm
     const SoaCloud soa = MakeSoa(cloud, remaining, origin);
     std::optional<CylinderModel> model = Ransac(soa, params, rng, distance, stop);
     if (!model) break;
+    // Gaps along the axis longer than this split the inliers; only the largest run is kept.
+    const double max_gap = std::max(2.0 * params.safety_length, model->radius);
     Eigen::Array<bool, Eigen::Dynamic, 1> is_inlier = distance.Compute(soa, *model) < threshold;
+    KeepLargestContiguousRun(soa, *model, max_gap, is_inlier);
     if (static_cast<std::uint64_t>(is_inlier.count()) < params.min_inliers) break;
 
     if (params.refine) {
@@ -173,6 +207,7 @@ std::vector<FittedCylinder> FitCylinders(const OrientedPoints& cloud, const Segm
       const auto refined = internal::RefineCylinder(inlier_points, *model);
       if (refined && RadiusInRange(*refined, params)) {
         Eigen::Array<bool, Eigen::Dynamic, 1> refined_inlier = distance.Compute(soa, *refined) < threshold;
+        KeepLargestContiguousRun(soa, *refined, max_gap, refined_inlier);
         if (static_cast<std::uint64_t>(refined_inlier.count()) >= params.min_inliers) {
           model = refined;
           is_inlier = std::move(refined_inlier);
@@ -191,6 +226,18 @@ std::vector<FittedCylinder> FitCylinders(const OrientedPoints& cloud, const Segm
       t_min = std::min(t_min, t);
       t_max = std::max(t_max, t);
       fitted.inliers.push_back(remaining[static_cast<std::size_t>(i)]);
+    }
+    if (t_max - t_min < model->radius) {
+      // Shorter than its radius (a sliver, e.g. the inside of an open tube end seen from above):
+      // its axis direction is unreliable and would mislead the joining's angle test. Its inliers
+      // are dropped without a cylinder and the fitting goes on with the other points.
+      std::vector<std::uint32_t> kept;
+      kept.reserve(remaining.size());
+      for (Eigen::Index i = 0; i < soa.size(); ++i) {
+        if (!is_inlier[i]) kept.push_back(remaining[static_cast<std::size_t>(i)]);
+      }
+      remaining = std::move(kept);
+      continue;
     }
     fitted.cylinder.start = origin + c + t_min * a;
     fitted.cylinder.end = origin + c + t_max * a;

@@ -81,7 +81,10 @@ ModelingParams FastModelingProfile() {
   p.cylinders.min_radius = 0.007;
   p.cylinders.max_radius = 0.018;
   p.cylinders.distance_threshold = 0.004;
-  p.cylinders.normal_distance_weight = 0.1;
+  // With a 4 mm threshold, 0.1 made the normal term dominate (inliers needed a normal within
+  // ~2° of radial; k = 40 normals have a median error of ~2°), so curved sections lost most of
+  // their inliers. 0.03 tolerates ~7° (tubepick eval: 94.0 % → 98.3 % correct, docs/ACCURACY.md).
+  p.cylinders.normal_distance_weight = 0.03;
   p.cylinders.max_iterations = 300;
   p.cylinders.probability = 0.99;
   p.cylinders.safety_length = 0.01;
@@ -91,7 +94,9 @@ ModelingParams FastModelingProfile() {
   p.cylinders.safety_radius = 0.03;
   p.cylinders.refine = true;
 
-  p.joining.strategy = JoiningStrategy::kGreedy;
+  // Global joining: same cost (< 1 ms), slightly more correct tubes than greedy on 200 simulated
+  // bins (98.6 % vs 98.3 %, 10 tubes: 9.65 vs 9.55 correct; docs/ACCURACY.md).
+  p.joining.strategy = JoiningStrategy::kGlobal;
   return p;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -258,6 +259,61 @@ TEST(FitCylinders, RejectsBadInputNamingTheKey) {
   params.distance_threshold = 0.0;
   EXPECT_THAT(error_of(params, {0, 1, 2}), HasSubstr("cylinders.distance_threshold"));
   EXPECT_THAT(error_of(CylinderFitParams{}, {0, 5}), HasSubstr("point index 5"));
+}
+
+// Keeps the points of `scene`'s segment whose x (bin frame) satisfies `keep`.
+template <typename Keep>
+Segment SegmentWhere(const Scene& scene, Keep keep) {
+  Segment out;
+  for (std::uint32_t i : scene.segment)
+    if (keep(scene.cloud.points[i].x())) out.push_back(i);
+  return out;
+}
+
+TEST(FitCylinders, NoCylinderSpansAHoleInTheSegment) {
+  // One straight tube whose middle 6 cm were taken by an earlier cylinder (§4.6.2): the two
+  // sides are collinear, but a cylinder must not bridge the hole (it would overlap the earlier
+  // one). Each side gets its own cylinder.
+  const Scene scene = MakeScene(FloorTube({{-0.15, 0.0}, {0.15, 0.0}}, kRadius));
+  const Segment sides = SegmentWhere(scene, [](float x) { return std::abs(x) > 0.03f; });
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    const std::vector<FittedCylinder> fits = FitCylinders(scene.cloud, sides, 0, CylinderFitParams{}, seed);
+    ASSERT_EQ(fits.size(), 2u);
+    for (const FittedCylinder& fit : fits) {
+      EXPECT_LT(fit.cylinder.length(), 0.13);
+      EXPECT_GT(fit.cylinder.start.x() * fit.cylinder.end.x(), 0.0) << "crosses the hole";
+    }
+  }
+}
+
+TEST(FitCylinders, PieceShorterThanItsRadiusGivesNoCylinder) {
+  // A 1 cm long piece of tube (enough points, but shorter than the 12.5 mm radius): its axis
+  // direction is unreliable, so no cylinder is made.
+  const Scene scene = MakeScene(FloorTube({{-0.15, 0.0}, {0.15, 0.0}}, kRadius));
+  const Segment piece = SegmentWhere(scene, [](float x) { return std::abs(x) < 0.005f; });
+  CylinderFitParams params;
+  params.min_inliers = 30;
+  ASSERT_GT(piece.size(), 2 * params.min_inliers);
+  EXPECT_TRUE(FitCylinders(scene.cloud, piece, 0, params, 1).empty());
+}
+
+TEST(FitCylinders, StrictNormalTermStillFitsEverySeed) {
+  // Normals with a few degrees of error (as from small neighbourhoods in dense scans) and an
+  // inlier test that allows only ~2° of it: many valid samples then have no inlier at all. The
+  // search must go on until it finds a real model instead of stopping after the first sample.
+  Scene scene = MakeScene(FloorTube({{-0.15, 0.0}, {0.15, 0.0}}, kRadius));
+  std::mt19937_64 rng(11);
+  std::normal_distribution<float> tilt(0.0f, static_cast<float>(2.5 * kDeg));
+  for (Eigen::Vector3f& n : scene.cloud.normals) {
+    if (n.allFinite()) n = (n + Eigen::Vector3f(tilt(rng), tilt(rng), tilt(rng))).normalized();
+  }
+  CylinderFitParams strict;
+  strict.distance_threshold = 0.004;
+  strict.normal_distance_weight = 0.1;
+  for (std::uint64_t seed = 0; seed < 30; ++seed) {
+    EXPECT_FALSE(FitCylinders(scene.cloud, scene.segment, 0, strict, seed).empty()) << "seed " << seed;
+  }
 }
 
 }  // namespace

@@ -1,0 +1,26 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/common/cell_config.h"
+#include "physics/bin_drop.h"
+#include "physics/virtual_scanner.h"
+
+namespace tubepick::cli {
+
+/// A simulated bin: random tubes dropped into the cell's bin and scanned from its sensor.
+struct SimulatedScene {
+  physics::DropResult drop;
+  /// Points in the sensor frame, metres, with per-point labels (index into drop.tubes).
+  physics::ScanResult scan;
+};
+
+/// `tube_count` tubes of `preset` ("A", "B", "C"; radius and mass from the cell) dropped into
+/// the cell's bin and scanned with the default scanner, all driven by `seed`. With preset A this
+/// is the same scene as the built-in one of `tubepick model --tubes N --seed S`.
+/// @throws InvalidArgument for an unknown preset or invalid parameters.
+SimulatedScene SimulateScene(const CellConfig& cell, int tube_count, const std::string& preset,
+                             std::uint64_t seed);
+
+}  // namespace tubepick::cli

@@ -1,0 +1,115 @@
+// End-to-end: `tubepick scene` writes two small simulated bins, `tubepick eval --scenes` models
+// and evaluates them and writes the report.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace tubepick {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+struct CliRun {
+  int exit_code;
+  std::string output;
+};
+
+CliRun RunCli(const std::string& args) {
+  const std::string cmd = std::string(TUBEPICK_CLI) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = pclose(pipe);
+  return {WEXITSTATUS(status), out};
+}
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("tubepick_cli_eval_test_" + name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(CliEval, SceneThenEvalWritesAConsistentReport) {
+  const fs::path dir = TempDir("e2e");
+  const fs::path scenes = dir / "scenes";
+  const CliRun one = RunCli("scene --tubes 1 --seed 1 --out " + (scenes / "one").string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const CliRun three = RunCli("scene --tubes 3 --preset A --seed 3 --out " + (scenes / "three").string());
+  ASSERT_EQ(three.exit_code, 0) << three.output;
+  for (const char* file : {"cloud.ply", "labels.txt", "tubes.txt", "cell.yaml", "scene.json"}) {
+    EXPECT_TRUE(fs::exists(scenes / "three" / file)) << file;
+  }
+  EXPECT_THAT(ReadText(scenes / "three" / "tubes.txt"), ::testing::StartsWith("3\n"));
+
+  const fs::path report = dir / "report";
+  const CliRun eval = RunCli("eval --scenes " + scenes.string() + " --report " + report.string());
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  EXPECT_THAT(eval.output, HasSubstr("2 scenes"));
+
+  const nlohmann::json j = nlohmann::json::parse(ReadText(report / "report.json"));
+  ASSERT_EQ(j["scenes"].size(), 2u);
+  EXPECT_EQ(j["profile"], "fast");
+  EXPECT_EQ(j["overall"]["scenes"], 2);
+  EXPECT_EQ(j["overall"]["real_tubes"], 4);
+  ASSERT_EQ(j["per_tube_count"].size(), 2u);
+  EXPECT_EQ(j["per_tube_count"][0]["tube_count"], 1);
+  EXPECT_EQ(j["per_tube_count"][1]["tube_count"], 3);
+  for (const auto& scene : j["scenes"]) {
+    SCOPED_TRACE(scene["name"].get<std::string>());
+    const int n = scene["tube_count"];
+    EXPECT_EQ(scene["real_tubes"].size(), static_cast<std::size_t>(n));
+    EXPECT_EQ(scene["correct"].get<int>() + scene["partially_correct"].get<int>() +
+                  scene["not_correct"].get<int>() + scene["hidden"].get<int>(),
+              n);
+    // Table 4.6: virtual tubes + the null row, real tubes + the background column.
+    EXPECT_EQ(scene["confusion"]["counts"].size(), scene["virtual_tubes"].size() + 1);
+    EXPECT_EQ(scene["confusion"]["counts"][0].size(), static_cast<std::size_t>(n) + 1);
+    EXPECT_GT(scene["filtered_points"].get<int>(), 1000);
+    EXPECT_GT(scene["total_seconds"].get<double>(), 0.0);
+  }
+  // A single tube alone in the bin is modeled correctly.
+  EXPECT_EQ(j["scenes"][0]["name"], "one");
+  EXPECT_EQ(j["scenes"][0]["correct"], 1);
+  EXPECT_GT(j["overall"]["micro_recall"].get<double>(), 0.9);
+  EXPECT_GE(j["overall"]["correct_fraction"].get<double>(), 0.75);
+
+  const std::string md = ReadText(report / "report.md");
+  EXPECT_THAT(md, HasSubstr("Table 4.5"));
+  EXPECT_THAT(md, HasSubstr("Table 4.4"));
+  EXPECT_THAT(md, HasSubstr("micro-recall"));
+  EXPECT_TRUE(fs::exists(report / "images" / "accuracy_time.svg"));
+  EXPECT_TRUE(fs::exists(report / "images" / "scene_one.svg"));
+  EXPECT_THAT(ReadText(report / "images" / "scene_one.svg"), HasSubstr("<svg"));
+  fs::remove_all(dir);
+}
+
+TEST(CliEval, NeedsExactlyOneSourceOfScenes) {
+  const fs::path dir = TempDir("usage");
+  const CliRun none = RunCli("eval --report " + (dir / "r").string());
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_THAT(none.output, HasSubstr("exactly one of --scenes, --generate, --configs"));
+  const CliRun bad = RunCli("eval --generate 3..1 --report " + (dir / "r").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_THAT(bad.output, HasSubstr("--generate"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace tubepick
