@@ -4,9 +4,7 @@
 
 #include <memory>
 
-#include "clients/cli/builtin_scene.h"
 #include "clients/cli/cli_inputs.h"
-#include "core/modeling/cloud_io.h"
 #include "core/modeling/model_tubes.h"
 #include "server/proto_convert.h"
 
@@ -14,12 +12,9 @@ namespace tubepick::cli {
 namespace {
 
 struct ModelOptions {
-  CommonOptions common;
-  std::string cloud_path;
-  std::string unit;  // empty = the cell's sensor unit
+  InputOptions input;
   std::string json_path;
   std::string dump_dir;
-  std::uint32_t builtin_tubes = 10;
 };
 
 void PrintSummary(const ModelingResult& r, const std::string& source) {
@@ -44,34 +39,17 @@ void PrintSummary(const ModelingResult& r, const std::string& source) {
 }
 
 void Run(const ModelOptions& o) {
-  const CellConfig cell = LoadCell(o.common);
-  const Params params = LoadParamsFor(o.common);
+  const CommonOptions& common = o.input.common;
+  const CellConfig cell = LoadCell(common);
+  const Params params = LoadParamsFor(common);
 
-  Points points_Sensor;
-  LengthUnit unit = o.unit.empty() ? cell.sensor.unit : ParseLengthUnit(o.unit, "--unit");
-  std::string source;
-  if (o.cloud_path.empty()) {
-    BuiltInScene scene = MakeBuiltInScene(cell, o.builtin_tubes, o.common.seed);
-    points_Sensor = std::move(scene.points_Sensor);
-    unit = LengthUnit::kMetre;
-    source = "built-in scene: " + scene.description;
-  } else {
-    CloudFile file = ReadCloudFile(o.cloud_path);
-    points_Sensor = std::move(file.points);
-    source = fmt::format("cloud {} ({}, unit {})", o.cloud_path, file.format, ToString(unit));
-  }
-
-  ModelingInput input;
-  input.points_Sensor = &points_Sensor;
-  input.unit = unit;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.seed = o.common.seed;
+  const CloudInput cloud = LoadCloudInput(o.input, cell);
+  const ModelingInput input = MakeModelingInput(cloud, cell, o.input.common.seed);
   const ModelingResult result = ModelTubes(input, params.modeling);
 
-  PrintSummary(result, source + fmt::format(", profile {}, seed {}", o.common.profile, o.common.seed));
+  PrintSummary(result, cloud.source + fmt::format(", profile {}, seed {}", common.profile, common.seed));
   if (!o.json_path.empty()) {
-    WriteTextFile(o.json_path, ToJson(ToModelTubesResponse(result, o.common.profile, o.common.seed)));
+    WriteTextFile(o.json_path, ToJson(ToModelTubesResponse(result, common.profile, common.seed)));
     fmt::print("wrote {}\n", o.json_path);
   }
   if (!o.dump_dir.empty()) {
@@ -85,23 +63,9 @@ void Run(const ModelOptions& o) {
 void AddModelCommand(CLI::App& app) {
   auto o = std::make_shared<ModelOptions>();
   CLI::App* cmd = app.add_subcommand("model", "Model the tubes of a point cloud (thesis Algorithm 1)");
-  cmd->add_option("--cloud", o->cloud_path, "PLY or PCD cloud in the sensor frame (default: built-in scene)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--cell", o->common.cell_path, "Cell YAML (default: embedded default cell)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--profile", o->common.profile, "Parameter profile")
-      ->check(CLI::IsMember({"fast", "thesis"}))
-      ->capture_default_str();
-  cmd->add_option("--params", o->common.params_path, "Params YAML applied on top of the profile")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--seed", o->common.seed, "Seed of every random step")->capture_default_str();
-  cmd->add_option("--unit", o->unit, "Unit of the cloud file (default: the cell's sensor.unit)")
-      ->check(CLI::IsMember({"m", "mm"}));
+  AddInputOptions(cmd, o->input);
   cmd->add_option("--json", o->json_path, "Write the ModelTubesResponse as proto3 JSON");
   cmd->add_option("--dump-stages", o->dump_dir, "Write intermediate clouds (PLY) into this directory");
-  cmd->add_option("--tubes", o->builtin_tubes, "Tubes in the built-in scene")
-      ->check(CLI::Range(1, 30))
-      ->capture_default_str();
   cmd->callback([o] { Run(*o); });
 }
 

@@ -4,9 +4,7 @@
 
 #include <memory>
 
-#include "clients/cli/builtin_scene.h"
 #include "clients/cli/cli_inputs.h"
-#include "core/modeling/cloud_io.h"
 #include "core/modeling/model_tubes.h"
 #include "core/planning/pick_planner.h"
 #include "core/planning/plan_placement.h"
@@ -17,11 +15,8 @@ namespace tubepick::cli {
 namespace {
 
 struct PlanOptions {
-  CommonOptions common;
-  std::string cloud_path;
-  std::string unit;
+  InputOptions input;
   std::string json_path;
-  std::uint32_t builtin_tubes = 10;
   bool no_sim = false;
   std::uint32_t sim_threads = 0;
   std::uint32_t show = 5;
@@ -42,27 +37,11 @@ const char* OcclusionName(Occlusion o) {
 }
 
 void Run(const PlanOptions& o) {
-  const CellConfig cell = LoadCell(o.common);
-  const Params params = LoadParamsFor(o.common);
-  Points points_Sensor;
-  LengthUnit unit = o.unit.empty() ? cell.sensor.unit : ParseLengthUnit(o.unit, "--unit");
-  std::string source;
-  if (o.cloud_path.empty()) {
-    BuiltInScene scene = MakeBuiltInScene(cell, o.builtin_tubes, o.common.seed);
-    points_Sensor = std::move(scene.points_Sensor);
-    unit = LengthUnit::kMetre;
-    source = "built-in scene: " + scene.description;
-  } else {
-    points_Sensor = ReadCloudFile(o.cloud_path).points;
-    source = "cloud " + o.cloud_path;
-  }
-
-  ModelingInput input;
-  input.points_Sensor = &points_Sensor;
-  input.unit = unit;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.seed = o.common.seed;
+  const CommonOptions& common = o.input.common;
+  const CellConfig cell = LoadCell(common);
+  const Params params = LoadParamsFor(common);
+  const CloudInput cloud = LoadCloudInput(o.input, cell);
+  const ModelingInput input = MakeModelingInput(cloud, cell, common.seed);
   const ModelingResult modeling = ModelTubes(input, params.modeling);
 
   physics::TrajectorySimParams sim;
@@ -72,10 +51,10 @@ void Run(const PlanOptions& o) {
   sim.threads = static_cast<int>(o.sim_threads);
   physics::BulletTrajectoryEvaluator evaluator(sim);
   PickPlanResult plan =
-      PlanPick(modeling, cell, params.planning, o.no_sim ? nullptr : &evaluator, o.common.seed);
+      PlanPick(modeling, cell, params.planning, o.no_sim ? nullptr : &evaluator, common.seed);
   AttachPlacements(modeling, cell.place.X_BinPlace, params.placement, &plan);
 
-  fmt::print("{}, profile {}, seed {}\n", source, o.common.profile, o.common.seed);
+  fmt::print("{}, profile {}, seed {}\n", cloud.source, common.profile, common.seed);
   fmt::print("modeling {:.3f} s: {} tubes; planning {:.3f} s: {} plans{}{}\n", modeling.total_seconds,
              modeling.tubes.size(), plan.total_seconds, plan.plans.size(),
              plan.used_simulation ? " (trajectories simulated)" : "", plan.bin_empty ? "; BIN EMPTY" : "");
@@ -93,7 +72,7 @@ void Run(const PlanOptions& o) {
                p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
   }
   if (!o.json_path.empty()) {
-    WriteTextFile(o.json_path, ToJson(ToPlanPickResponse(plan, modeling, o.common.profile, o.common.seed)));
+    WriteTextFile(o.json_path, ToJson(ToPlanPickResponse(plan, modeling, common.profile, common.seed)));
     fmt::print("wrote {}\n", o.json_path);
   }
 }
@@ -103,22 +82,8 @@ void Run(const PlanOptions& o) {
 void AddPlanCommand(CLI::App& app) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* cmd = app.add_subcommand("plan", "Plan ranked picks for a cloud (thesis chapter 5)");
-  cmd->add_option("--cloud", o->cloud_path, "PLY or PCD cloud in the sensor frame (default: built-in scene)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--cell", o->common.cell_path, "Cell YAML (default: embedded default cell)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--profile", o->common.profile, "Parameter profile")
-      ->check(CLI::IsMember({"fast", "thesis"}))
-      ->capture_default_str();
-  cmd->add_option("--params", o->common.params_path, "Params YAML applied on top of the profile")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--seed", o->common.seed, "Seed of every random step")->capture_default_str();
-  cmd->add_option("--unit", o->unit, "Unit of the cloud file (default: the cell's sensor.unit)")
-      ->check(CLI::IsMember({"m", "mm"}));
+  AddInputOptions(cmd, o->input);
   cmd->add_option("--json", o->json_path, "Write the PlanPickResponse as proto3 JSON");
-  cmd->add_option("--tubes", o->builtin_tubes, "Tubes in the built-in scene")
-      ->check(CLI::Range(1, 30))
-      ->capture_default_str();
   cmd->add_flag("--no-sim", o->no_sim, "Never simulate trajectories (occluded tubes get T = 0)");
   cmd->add_option("--sim-threads", o->sim_threads, "Simulation worker threads (0 = all cores)")
       ->capture_default_str();
