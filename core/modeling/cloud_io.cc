@@ -86,6 +86,18 @@ void AppendNumber(std::string* out, float value) {
   out->append(buffer, ec == std::errc() ? ptr : buffer);
 }
 
+void AppendAsciiPoints(std::string* out, const Points& points) {
+  out->reserve(out->size() + points.size() * 30);
+  for (const Eigen::Vector3f& p : points) {
+    AppendNumber(out, p.x());
+    *out += ' ';
+    AppendNumber(out, p.y());
+    *out += ' ';
+    AppendNumber(out, p.z());
+    *out += '\n';
+  }
+}
+
 void StoreFloatLE(char* dst, float value) {
   const auto bits = std::bit_cast<std::uint32_t>(value);
   for (int i = 0; i < 4; ++i) dst[i] = static_cast<char>((bits >> (8 * i)) & 0xffu);

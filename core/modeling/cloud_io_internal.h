@@ -60,6 +60,9 @@ bool ParseNumber(std::string_view token, std::uint64_t* value);
 /// Appends the shortest decimal text that reads back as exactly `value`.
 void AppendNumber(std::string* out, float value);
 
+/// Appends one "x y z\n" line per point (ASCII PLY and PCD bodies).
+void AppendAsciiPoints(std::string* out, const Points& points);
+
 /// count × size as text for error messages ("over 2^64" when it overflows).
 inline std::string ByteCountText(std::uint64_t count, std::uint64_t size) {
   if (size != 0 && count > std::numeric_limits<std::uint64_t>::max() / size) return "over 2^64";

@@ -358,15 +358,7 @@ void WritePcd(const std::string& path, const Points& points, bool binary) {
       for (int axis = 0; axis < 3; ++axis, data += 4) internal::StoreFloatLE(data, p[axis]);
     }
   } else {
-    out.reserve(out.size() + points.size() * 30);
-    for (const Eigen::Vector3f& p : points) {
-      internal::AppendNumber(&out, p.x());
-      out += ' ';
-      internal::AppendNumber(&out, p.y());
-      out += ' ';
-      internal::AppendNumber(&out, p.z());
-      out += '\n';
-    }
+    internal::AppendAsciiPoints(&out, points);
   }
   internal::WriteFileBytes(path, out);
 }

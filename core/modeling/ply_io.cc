@@ -439,15 +439,7 @@ void WritePlyAscii(const std::string& path, const Points& points) {
   std::string out = "ply\nformat ascii 1.0\ncomment written by tubepick\nelement vertex " +
                     std::to_string(points.size()) +
                     "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  out.reserve(out.size() + points.size() * 30);
-  for (const Eigen::Vector3f& p : points) {
-    internal::AppendNumber(&out, p.x());
-    out += ' ';
-    internal::AppendNumber(&out, p.y());
-    out += ' ';
-    internal::AppendNumber(&out, p.z());
-    out += '\n';
-  }
+  internal::AppendAsciiPoints(&out, points);
   internal::WriteFileBytes(path, out);
 }
 
