@@ -38,7 +38,8 @@ class Gripper {
   virtual GripperStatus Open(Timeout timeout) = 0;
   /// Closes until contact or fully closed. @throws DeviceTimeout, DeviceFault.
   virtual GripperStatus Close(double speed, double force, Timeout timeout) = 0;
-  /// @throws DeviceTimeout, DeviceFault.
+  /// The current status; a gripper fault is reported in GripperStatus::fault (not thrown), so a
+  /// caller can inspect it. @throws DeviceTimeout, or DeviceFault when the link itself fails.
   virtual GripperStatus Status(Timeout timeout) = 0;
 };
 
