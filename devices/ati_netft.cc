@@ -1,15 +1,8 @@
 #include "devices/ati_netft.h"
 
-#include <netdb.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <sys/types.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -81,7 +74,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string Errno(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
+AtiNetFtParams Validated(AtiNetFtParams params) {
+  if (params.counts_per_force == 0.0 || params.counts_per_torque == 0.0) {
+    throw std::invalid_argument("AtiNetFt: counts per force/torque must be non-zero");
+  }
+  return params;
+}
 
 std::string Hex32(std::uint32_t v) {
   char buf[16];
@@ -91,108 +89,40 @@ std::string Hex32(std::uint32_t v) {
 
 }  // namespace
 
-AtiNetFt::AtiNetFt(AtiNetFtParams params) : params_(std::move(params)) {
-  if (params_.counts_per_force == 0.0 || params_.counts_per_torque == 0.0) {
-    throw std::invalid_argument("AtiNetFt: counts per force/torque must be non-zero");
-  }
-  addrinfo hints{};
-  hints.ai_family = AF_INET;
-  hints.ai_socktype = SOCK_DGRAM;
-  addrinfo* found = nullptr;
-  const std::string port = std::to_string(params_.port);
-  if (const int rc = ::getaddrinfo(params_.host.c_str(), port.c_str(), &hints, &found); rc != 0) {
-    throw DeviceFault("ATI Net F/T: cannot resolve '" + params_.host + "': " + ::gai_strerror(rc));
-  }
-  fd_ = ::socket(found->ai_family, found->ai_socktype | SOCK_CLOEXEC, found->ai_protocol);
-  if (fd_ < 0) {
-    ::freeaddrinfo(found);
-    throw DeviceFault(Errno("ATI Net F/T: socket"));
-  }
-  // A connected UDP socket only receives datagrams from the sensor's address.
-  const int rc = ::connect(fd_, found->ai_addr, found->ai_addrlen);
-  ::freeaddrinfo(found);
-  if (rc != 0) {
-    const std::string message = Errno("ATI Net F/T: connect");
-    ::close(fd_);
-    throw DeviceFault(message);
-  }
-}
-
-AtiNetFt::~AtiNetFt() {
-  if (fd_ >= 0) {
-    ::close(fd_);
-  }
-}
-
-void AtiNetFt::DrainStale() {
-  // Late records of an earlier, timed-out request must not answer this one.
-  std::uint8_t buf[256];
-  while (::recv(fd_, buf, sizeof buf, MSG_DONTWAIT) >= 0) {
-  }
-}
-
-void AtiNetFt::Send(const rdt::RequestBytes& bytes, Timeout timeout) {
-  pollfd pfd{fd_, POLLOUT, 0};
-  const int ready = ::poll(&pfd, 1, static_cast<int>(timeout.count()));
-  if (ready == 0) {
-    throw DeviceTimeout("ATI Net F/T: send not possible within " + std::to_string(timeout.count()) + " ms");
-  }
-  if (ready < 0) {
-    throw DeviceFault(Errno("ATI Net F/T: poll"));
-  }
-  const ssize_t sent = ::send(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT);
-  if (sent != static_cast<ssize_t>(bytes.size())) {
-    throw DeviceFault(Errno("ATI Net F/T: send"));
-  }
-}
+AtiNetFt::AtiNetFt(AtiNetFtParams params)
+    : params_(Validated(std::move(params))),
+      udp_(params_.host, params_.port, "ATI Net F/T " + params_.host) {}
 
 WrenchReading AtiNetFt::Read(Timeout timeout) {
   const auto deadline = Clock::now() + timeout;
-  DrainStale();
-  Send(rdt::EncodeRequest(rdt::Command::kStartRealtime, 1), timeout);
+  udp_.DrainStale();
+  udp_.Send(rdt::EncodeRequest(rdt::Command::kStartRealtime, 1), deadline);
   std::uint8_t buf[rdt::kRecordSize + 1];
-  for (;;) {
-    // Rounded up, so the wait never ends before the deadline.
-    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now()).count();
-    pollfd pfd{fd_, POLLIN, 0};
-    const int ready = left > 0 ? ::poll(&pfd, 1, static_cast<int>(left)) : 0;
-    if (ready == 0) {
-      throw DeviceTimeout("ATI Net F/T " + params_.host + ": no RDT record within " +
-                          std::to_string(timeout.count()) + " ms");
-    }
-    if (ready < 0) {
-      if (errno == EINTR) {
-        continue;
-      }
-      throw DeviceFault(Errno("ATI Net F/T: poll"));
-    }
-    const ssize_t got = ::recv(fd_, buf, sizeof buf, MSG_DONTWAIT);
-    if (got < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
-        continue;
-      }
-      // E.g. ECONNREFUSED from an ICMP port-unreachable: nothing listens at host:port.
-      throw DeviceFault(Errno(("ATI Net F/T " + params_.host + ": recv").c_str()));
-    }
-    if (got != static_cast<ssize_t>(rdt::kRecordSize)) {
-      throw DeviceFault("ATI Net F/T: unexpected reply of " + std::to_string(got) +
-                        " bytes (an RDT record has 36)");
-    }
-    const rdt::Record record =
-        rdt::DecodeRecord(std::span<const std::uint8_t, rdt::kRecordSize>(buf, rdt::kRecordSize));
-    if (record.status != 0) {
-      throw DeviceFault("ATI Net F/T: status word " + Hex32(record.status));
-    }
-    WrenchReading reading;
-    for (int i = 0; i < 3; ++i) {
-      reading.force[i] = record.counts[i] / params_.counts_per_force;
-      reading.torque[i] = record.counts[3 + i] / params_.counts_per_torque;
-    }
-    reading.sequence = record.ft_sequence;
-    return reading;
+  const std::optional<std::size_t> got = udp_.Receive(buf, deadline);
+  if (!got) {
+    throw DeviceTimeout("ATI Net F/T " + params_.host + ": no RDT record within " +
+                        std::to_string(timeout.count()) + " ms");
   }
+  if (*got != rdt::kRecordSize) {
+    throw DeviceFault("ATI Net F/T: unexpected reply of " + std::to_string(*got) +
+                      " bytes (an RDT record has 36)");
+  }
+  const rdt::Record record =
+      rdt::DecodeRecord(std::span<const std::uint8_t, rdt::kRecordSize>(buf, rdt::kRecordSize));
+  if (record.status != 0) {
+    throw DeviceFault("ATI Net F/T: status word " + Hex32(record.status));
+  }
+  WrenchReading reading;
+  for (int i = 0; i < 3; ++i) {
+    reading.force[i] = record.counts[i] / params_.counts_per_force;
+    reading.torque[i] = record.counts[3 + i] / params_.counts_per_torque;
+  }
+  reading.sequence = record.ft_sequence;
+  return reading;
 }
 
-void AtiNetFt::Bias(Timeout timeout) { Send(rdt::EncodeRequest(rdt::Command::kSetSoftwareBias, 0), timeout); }
+void AtiNetFt::Bias(Timeout timeout) {
+  udp_.Send(rdt::EncodeRequest(rdt::Command::kSetSoftwareBias, 0), Clock::now() + timeout);
+}
 
 }  // namespace tubepick::devices

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "devices/force_torque_sensor.h"
+#include "devices/udp_client.h"
 
 namespace tubepick::devices {
 
@@ -73,9 +74,6 @@ class AtiNetFt final : public ForceTorqueSensor {
   /// Opens the UDP socket towards params.host:params.port. @throws DeviceFault when the host
   /// does not resolve or the socket cannot be created; std::invalid_argument on zero counts.
   explicit AtiNetFt(AtiNetFtParams params);
-  ~AtiNetFt() override;
-  AtiNetFt(const AtiNetFt&) = delete;
-  AtiNetFt& operator=(const AtiNetFt&) = delete;
 
   /// @throws DeviceTimeout when no record arrives in time; DeviceFault on a non-zero status
   /// word (hex in the message), a malformed reply or a socket error.
@@ -87,11 +85,8 @@ class AtiNetFt final : public ForceTorqueSensor {
   const AtiNetFtParams& params() const { return params_; }
 
  private:
-  void Send(const rdt::RequestBytes& bytes, Timeout timeout);
-  void DrainStale();
-
   AtiNetFtParams params_;
-  int fd_ = -1;
+  UdpClient udp_;
 };
 
 }  // namespace tubepick::devices

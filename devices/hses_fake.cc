@@ -1,24 +1,11 @@
 #include "devices/hses_fake.h"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
-#include <stdexcept>
 #include <string>
 
 namespace tubepick::devices {
 namespace {
-
-std::runtime_error SysError(const char* what) {
-  return std::runtime_error(std::string("HsesFake: ") + what + ": " + std::strerror(errno));
-}
 
 constexpr std::uint8_t kStatusUndefinedCommand = 0x08;
 constexpr std::uint8_t kStatusError = 0x1F;
@@ -28,34 +15,9 @@ constexpr std::uint16_t kAddedUndefinedCommand = 0xA000;
 
 }  // namespace
 
-HsesFake::HsesFake(std::chrono::milliseconds move_duration) : move_duration_(move_duration) {
-  fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) {
-    throw SysError("socket");
-  }
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  addr.sin_port = 0;
-  socklen_t len = sizeof addr;
-  if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 ||
-      ::getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len) != 0 || ::pipe2(wake_, O_CLOEXEC) != 0) {
-    const auto error = SysError("bind/getsockname/pipe");
-    ::close(fd_);
-    throw error;
-  }
-  port_ = ntohs(addr.sin_port);
-  thread_ = std::thread([this] { Run(); });
-}
-
-HsesFake::~HsesFake() {
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
-  thread_.join();
-  ::close(fd_);
-  ::close(wake_[0]);
-  ::close(wake_[1]);
-}
+HsesFake::HsesFake(std::chrono::milliseconds move_duration)
+    : move_duration_(move_duration),
+      server_("HsesFake", [this](std::span<const std::uint8_t> d) { return Serve(d); }) {}
 
 void HsesFake::SetErrorStatus(std::uint8_t status, std::uint16_t added_status) {
   std::lock_guard lock(mutex_);
@@ -163,45 +125,17 @@ hses::Answer HsesFake::Handle(const hses::Request& request) {
   return fail(kStatusUndefinedCommand, kAddedUndefinedCommand);
 }
 
-void HsesFake::Run() {
-  for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) {
-        continue;
-      }
-      return;
-    }
-    if (fds[1].revents != 0) {
-      return;
-    }
-    if ((fds[0].revents & POLLIN) == 0) {
-      continue;
-    }
-    std::uint8_t buf[512];
-    sockaddr_in peer{};
-    socklen_t peer_len = sizeof peer;
-    const ssize_t got =
-        ::recvfrom(fd_, buf, sizeof buf, MSG_DONTWAIT, reinterpret_cast<sockaddr*>(&peer), &peer_len);
-    if (got < 0) {
-      continue;
-    }
-    const auto request =
-        hses::DecodeRequest(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(got)));
-    if (!request) {
-      continue;
-    }
-    std::vector<std::uint8_t> reply;
-    {
-      std::lock_guard lock(mutex_);
-      requests_.push_back(*request);
-      if (silent_) {
-        continue;
-      }
-      reply = hses::EncodeAnswer(Handle(*request));
-    }
-    ::sendto(fd_, reply.data(), reply.size(), 0, reinterpret_cast<const sockaddr*>(&peer), peer_len);
+std::vector<LoopbackUdpServer::Datagram> HsesFake::Serve(std::span<const std::uint8_t> datagram) {
+  const auto request = hses::DecodeRequest(datagram);
+  if (!request) {
+    return {};
   }
+  std::lock_guard lock(mutex_);
+  requests_.push_back(*request);
+  if (silent_) {
+    return {};
+  }
+  return {hses::EncodeAnswer(Handle(*request))};
 }
 
 }  // namespace tubepick::devices

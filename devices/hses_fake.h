@@ -4,9 +4,10 @@
 #include <chrono>
 #include <cstdint>
 #include <mutex>
-#include <thread>
+#include <span>
 #include <vector>
 
+#include "devices/loopback_udp_server.h"
 #include "devices/yaskawa_hses.h"
 
 namespace tubepick::devices {
@@ -19,11 +20,8 @@ namespace tubepick::devices {
 class HsesFake {
  public:
   explicit HsesFake(std::chrono::milliseconds move_duration = std::chrono::milliseconds(50));
-  ~HsesFake();
-  HsesFake(const HsesFake&) = delete;
-  HsesFake& operator=(const HsesFake&) = delete;
 
-  std::uint16_t port() const { return port_; }
+  std::uint16_t port() const { return server_.port(); }
 
   /// Every answer from now on carries this status and added status (0, 0 = normal).
   void SetErrorStatus(std::uint8_t status, std::uint16_t added_status);
@@ -40,12 +38,9 @@ class HsesFake {
   std::vector<std::array<std::int32_t, hses::kMoveWords>> moves() const;
 
  private:
-  void Run();
+  std::vector<LoopbackUdpServer::Datagram> Serve(std::span<const std::uint8_t> datagram);
   hses::Answer Handle(const hses::Request& request);
 
-  int fd_ = -1;
-  int wake_[2] = {-1, -1};
-  std::uint16_t port_ = 0;
   std::chrono::milliseconds move_duration_;
 
   mutable std::mutex mutex_;
@@ -61,7 +56,7 @@ class HsesFake {
   std::vector<hses::Request> requests_;
   std::vector<std::array<std::int32_t, hses::kMoveWords>> moves_;
 
-  std::thread thread_;
+  LoopbackUdpServer server_;  // last: its thread stops before the state above is destroyed
 };
 
 }  // namespace tubepick::devices

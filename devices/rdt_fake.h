@@ -5,10 +5,11 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
-#include <thread>
+#include <span>
 #include <vector>
 
 #include "devices/ati_netft.h"
+#include "devices/loopback_udp_server.h"
 
 namespace tubepick::devices {
 
@@ -20,11 +21,8 @@ namespace tubepick::devices {
 class RdtFake {
  public:
   RdtFake();
-  ~RdtFake();
-  RdtFake(const RdtFake&) = delete;
-  RdtFake& operator=(const RdtFake&) = delete;
 
-  std::uint16_t port() const { return port_; }
+  std::uint16_t port() const { return server_.port(); }
 
   /// The counts (Fx, Fy, Fz, Tx, Ty, Tz) and status word of the records sent from now on.
   void SetReply(const std::array<std::int32_t, 6>& counts, std::uint32_t status = 0);
@@ -35,11 +33,7 @@ class RdtFake {
   std::vector<rdt::RequestBytes> requests() const;
 
  private:
-  void Run();
-
-  int fd_ = -1;
-  int wake_[2] = {-1, -1};  // pipe: the destructor writes to wake the thread
-  std::uint16_t port_ = 0;
+  std::vector<LoopbackUdpServer::Datagram> Handle(std::span<const std::uint8_t> datagram);
 
   mutable std::mutex mutex_;
   std::array<std::int32_t, 6> counts_{};
@@ -49,7 +43,7 @@ class RdtFake {
   std::uint32_t ft_sequence_ = 0;
   std::vector<rdt::RequestBytes> requests_;
 
-  std::thread thread_;
+  LoopbackUdpServer server_;  // last: its thread stops before the state above is destroyed
 };
 
 }  // namespace tubepick::devices

@@ -1,18 +1,11 @@
 #include "devices/yaskawa_hses.h"
 
-#include <netdb.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <sys/types.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <numbers>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -180,8 +173,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
-
 std::string Hex(unsigned v, int digits) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "0x%0*X", digits, v);
@@ -190,69 +181,22 @@ std::string Hex(unsigned v, int digits) {
 
 }  // namespace
 
-YaskawaHses::YaskawaHses(YaskawaHsesParams params) : params_(std::move(params)) {
-  addrinfo hints{};
-  hints.ai_family = AF_INET;
-  hints.ai_socktype = SOCK_DGRAM;
-  addrinfo* found = nullptr;
-  const std::string port = std::to_string(params_.port);
-  if (const int rc = ::getaddrinfo(params_.host.c_str(), port.c_str(), &hints, &found); rc != 0) {
-    throw DeviceFault("Yaskawa HSES: cannot resolve '" + params_.host + "': " + ::gai_strerror(rc));
-  }
-  fd_ = ::socket(found->ai_family, found->ai_socktype | SOCK_CLOEXEC, found->ai_protocol);
-  if (fd_ < 0) {
-    ::freeaddrinfo(found);
-    throw DeviceFault(Errno("Yaskawa HSES: socket"));
-  }
-  const int rc = ::connect(fd_, found->ai_addr, found->ai_addrlen);
-  ::freeaddrinfo(found);
-  if (rc != 0) {
-    const std::string message = Errno("Yaskawa HSES: connect");
-    ::close(fd_);
-    throw DeviceFault(message);
-  }
-}
-
-YaskawaHses::~YaskawaHses() {
-  if (fd_ >= 0) {
-    ::close(fd_);
-  }
-}
+YaskawaHses::YaskawaHses(YaskawaHsesParams params)
+    : params_(std::move(params)), udp_(params_.host, params_.port, "Yaskawa HSES " + params_.host) {}
 
 hses::Answer YaskawaHses::Transact(hses::Request request, TimePoint deadline, Timeout timeout) {
   const std::string who = "Yaskawa HSES " + params_.host + " command " + Hex(request.command, 2);
   std::uint8_t buf[512];
-  while (::recv(fd_, buf, sizeof buf, MSG_DONTWAIT) >= 0) {
-    // Late answers of an earlier, timed-out request must not answer this one.
-  }
+  udp_.DrainStale();  // late answers of an earlier, timed-out request must not answer this one
   request.request_id = next_request_id_++;
   const std::vector<std::uint8_t> bytes = hses::EncodeRequest(request);
-  if (::send(fd_, bytes.data(), bytes.size(), 0) != static_cast<ssize_t>(bytes.size())) {
-    throw DeviceFault(Errno(who + ": send"));
-  }
+  udp_.Send(bytes, deadline);
   for (;;) {
-    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now()).count();
-    pollfd pfd{fd_, POLLIN, 0};
-    const int ready = left > 0 ? ::poll(&pfd, 1, static_cast<int>(left)) : 0;
-    if (ready == 0) {
-      throw DeviceTimeout(who + ": no answer within " + std::to_string(timeout.count()) + " ms");
-    }
-    if (ready < 0) {
-      if (errno == EINTR) {
-        continue;
-      }
-      throw DeviceFault(Errno(who + ": poll"));
-    }
-    const ssize_t got = ::recv(fd_, buf, sizeof buf, MSG_DONTWAIT);
-    if (got < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
-        continue;
-      }
-      throw DeviceFault(Errno(who + ": recv"));
-    }
-    const auto answer = hses::DecodeAnswer(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(got)));
+    const std::optional<std::size_t> got = udp_.Receive(buf, deadline);
+    if (!got) throw DeviceTimeout(who + ": no answer within " + std::to_string(timeout.count()) + " ms");
+    const auto answer = hses::DecodeAnswer(std::span<const std::uint8_t>(buf, *got));
     if (!answer) {
-      throw DeviceFault(who + ": malformed answer of " + std::to_string(got) + " bytes");
+      throw DeviceFault(who + ": malformed answer of " + std::to_string(*got) + " bytes");
     }
     if (answer->request_id != request.request_id) {
       continue;  // a stale answer

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "devices/robot.h"
+#include "devices/udp_client.h"
 
 namespace tubepick::devices {
 
@@ -106,9 +107,6 @@ class YaskawaHses final : public Robot {
  public:
   /// @throws DeviceFault when the host does not resolve or the socket cannot be created.
   explicit YaskawaHses(YaskawaHsesParams params);
-  ~YaskawaHses() override;
-  YaskawaHses(const YaskawaHses&) = delete;
-  YaskawaHses& operator=(const YaskawaHses&) = delete;
 
   /// Straight move (0x8A), then status polls (0x72) until the running bit clears.
   /// @throws DeviceTimeout, DeviceFault (answer status/added status in hex, alarm/error bit).
@@ -128,7 +126,7 @@ class YaskawaHses final : public Robot {
   Eigen::Isometry3d PoseUntil(TimePoint deadline, Timeout timeout);
 
   YaskawaHsesParams params_;
-  int fd_ = -1;
+  UdpClient udp_;
   std::uint8_t next_request_id_ = 0;
 };
 
