@@ -1,0 +1,25 @@
+#pragma once
+
+#include "core/common/stop_token.h"
+#include "server/request_validation.h"
+#include "server/server_config.h"
+#include "tubepick/v1/modeling.pb.h"
+#include "tubepick/v1/planning.pb.h"
+#include "tubepick/v1/wrench.pb.h"
+
+namespace tubepick::server {
+
+/// The work behind each RPC, independent of gRPC (runs on a planning worker). `stop` is polled in
+/// modeling and simulation loops: a cancelled or expired call throws tubepick::Cancelled within
+/// ~100 ms. Core InvalidArgument (e.g. a degenerate cloud) propagates.
+
+v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, const StopToken* stop);
+
+/// Models, classifies, simulates (unless job.disable_simulation) with `simulation_threads` threads,
+/// ranks, attaches placements, truncates to job.max_plans.
+v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults& defaults,
+                                 int simulation_threads, const StopToken* stop);
+
+v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job);
+
+}  // namespace tubepick::server
