@@ -11,7 +11,7 @@ packages=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libmodbus-dev libgtest-dev libgmock-dev libbenchmark-dev
-  openssl curl nodejs npm
+  openssl curl
 )
 
 missing=()
