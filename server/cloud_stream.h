@@ -39,8 +39,13 @@ class CloudStreamAssembler {
  private:
   std::uint64_t max_total_bytes_;
   std::optional<v1::PlanPickStreamHeader> header_;
+  /// Chunks that arrived ahead of `next_index_`, by index.
   std::map<std::uint32_t, std::string> chunks_;
   std::uint64_t received_bytes_ = 0;
+  /// Chunks 0 .. next_index_ - 1 joined in order (in-order streams never copy twice), and their CRC.
+  std::string joined_;
+  std::uint32_t next_index_ = 0;
+  std::uint32_t crc_ = 0;
 };
 
 }  // namespace tubepick::server

@@ -15,11 +15,15 @@ namespace tubepick::server {
 
 v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, const StopToken* stop);
 
-/// Models, classifies, simulates (unless job.disable_simulation) with `simulation_threads` threads,
-/// ranks, attaches placements, truncates to job.max_plans.
+/// Models, classifies, simulates (unless job.disable_simulation) with `simulation_threads` threads
+/// (0 = hardware threads; the outcome does not depend on it), ranks, truncates to job.max_plans
+/// (0 = all), attaches placements. Same job ⇒ the same response except its timings.
 v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults& defaults,
                                  int simulation_threads, const StopToken* stop);
 
+/// Algorithm 3 (CountHeldTubes with job.params.up_Tcp) and, when several tubes are held, the
+/// horizontal torque change and PlanResolutionRotation's motions (none when |ΔM| < min_torque).
+/// Fast and bounded: runs without a stop token.
 v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job);
 
 }  // namespace tubepick::server

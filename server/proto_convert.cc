@@ -119,6 +119,78 @@ v1::PlanPickResponse ToPlanPickResponse(const PickPlanResult& result, const Mode
   return response;
 }
 
+v1::HeldOutcome ToProto(HeldOutcome outcome) {
+  switch (outcome) {
+    case HeldOutcome::kNone:
+      return v1::HELD_OUTCOME_NONE;
+    case HeldOutcome::kSingle:
+      return v1::HELD_OUTCOME_SINGLE;
+    case HeldOutcome::kMultiple:
+      return v1::HELD_OUTCOME_MULTIPLE;
+  }
+  return v1::HELD_OUTCOME_UNSPECIFIED;
+}
+
+v1::ResolutionVariant ToProto(ResolutionVariant variant) {
+  switch (variant) {
+    case ResolutionVariant::kTorqueAxis:
+      return v1::RESOLUTION_VARIANT_TORQUE_AXIS;
+    case ResolutionVariant::kTorqueAxisNegative:
+      return v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE;
+    case ResolutionVariant::kPerpendicular:
+      return v1::RESOLUTION_VARIANT_PERPENDICULAR;
+    case ResolutionVariant::kJointSafe:
+      return v1::RESOLUTION_VARIANT_JOINT_SAFE;
+  }
+  return v1::RESOLUTION_VARIANT_UNSPECIFIED;
+}
+
+std::optional<ResolutionVariant> FromProto(v1::ResolutionVariant variant) {
+  switch (static_cast<int>(variant)) {
+    case v1::RESOLUTION_VARIANT_TORQUE_AXIS:
+      return ResolutionVariant::kTorqueAxis;
+    case v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE:
+      return ResolutionVariant::kTorqueAxisNegative;
+    case v1::RESOLUTION_VARIANT_PERPENDICULAR:
+      return ResolutionVariant::kPerpendicular;
+    case v1::RESOLUTION_VARIANT_JOINT_SAFE:
+      return ResolutionVariant::kJointSafe;
+    default:
+      return std::nullopt;
+  }
+}
+
+void ToProto(const ResolutionMotion& motion, v1::ResolutionMotion* out) {
+  ToProto(motion.axis_Tcp, out->mutable_axis_tcp());
+  out->set_angle(motion.angle);
+  out->set_yaw(motion.yaw);
+  for (const ResolutionWaypoint& w : motion.waypoints) {
+    v1::ResolutionWaypoint* pw = out->add_waypoints();
+    ToProto(w.X_BinTcpRotated, pw->mutable_tcp_pose());
+    pw->set_description(w.description);
+  }
+  out->set_description(motion.description);
+}
+
+v1::AnalyzeWrenchResponse ToAnalyzeWrenchResponse(const HeldCount& count,
+                                                  const std::optional<ResolutionPlan>& resolution,
+                                                  const Eigen::Vector3d& delta_torque_Tcp) {
+  v1::AnalyzeWrenchResponse response;
+  response.set_outcome(ToProto(count.outcome));
+  response.set_estimated_count(count.estimated_count);
+  response.set_tube_weight(count.tube_weight);
+  response.set_expected_force(count.expected_force);
+  response.set_held_weight(count.held_weight);
+  response.set_tube_ratio(count.tube_ratio);
+  if (count.outcome == HeldOutcome::kMultiple) {
+    ToProto(delta_torque_Tcp, response.mutable_delta_torque_tcp());
+    if (resolution) {
+      for (const ResolutionMotion& m : resolution->motions) ToProto(m, response.add_resolution_motions());
+    }
+  }
+  return response;
+}
+
 std::string ToJson(const google::protobuf::Message& message, bool pretty) {
   google::protobuf::util::JsonPrintOptions options;
   options.add_whitespace = pretty;

@@ -34,14 +34,23 @@ struct PlanningJob {
 /// decodes it (little-endian). @throws InvalidArgument naming `field`.
 Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::string& field);
 
-/// The cell of a request: `defaults.cell` when absent, else every field checked (finite, poses with
-/// unit quaternions within 1e-3 — normalised —, radius in (0, 0.5] m, mass in (0, 100] kg, ...).
+/// The cell of a request: `defaults.cell` when absent, else every field required and checked:
+/// finite; poses with unit quaternions within 1e-3 (then normalised; a zero quaternion is an error);
+/// bin sides in [0.01, 10] m; the sensor above the floor; tube radius in [0.001, 0.2] m, length in
+/// [0, 10] m, mass in [0.001, 50] kg (CellConfig::Validate's limits, which planning applies again).
+/// The sensor unit is the server cell's (CellDescription has none). `field` prefixes messages.
 CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults& defaults,
                         const std::string& field);
 
+/// Cloud (DecodeCloud, `defaults.max_cloud_points`), cell (ValidateCell), cloud.unit (UNSPECIFIED ⇒
+/// the cell's sensor unit; numbers the enum does not define are errors), options.profile (empty ⇒
+/// defaults.profile; unknown ⇒ error listing the known ones), options.seed (absent ⇒ defaults.seed).
 PlanningJob ValidateModelTubes(const v1::ModelTubesRequest& request, const PlanningDefaults& defaults);
+/// As ValidateModelTubes, and the tube must fit the profile's gripper opening
+/// (2 · tube radius < planning.grasps.opening_width).
 PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, const PlanningDefaults& defaults);
 /// PlanPickStream: the header's request (whose cloud.xyz must be empty) and the joined bytes.
+/// Fields are named as in the stream ("header.request.cell.tube_radius").
 PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, std::string_view cloud_xyz,
                              const PlanningDefaults& defaults);
 
@@ -53,6 +62,13 @@ struct WrenchJob {
   Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
   WrenchParams params;
 };
+/// reference, current and tcp_pose are required; tube_mass absent ⇒ defaults.cell's, in
+/// [0.001, 50] kg and heavier than wrench.force_tolerance; variant UNSPECIFIED ⇒ the profile's. The
+/// params are defaults.profiles[defaults.profile].wrench with up_Tcp = R_BinTcpᵀ · z_Bin: the pose
+/// defines the vertical in the sensor frame (axes = TCP's), so a grasp TCP with z pointing down
+/// gives (0, 0, −1). The TCP z axis must be within wrench.max_tilt of the vertical (the resolution
+/// planner's own tilt check always passes with this up_Tcp); a joint-safe axis in the TCP frame is
+/// re-projected onto the horizontal plane of this pose.
 WrenchJob ValidateAnalyzeWrench(const v1::AnalyzeWrenchRequest& request, const PlanningDefaults& defaults);
 
 }  // namespace tubepick::server

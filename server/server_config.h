@@ -23,6 +23,9 @@ struct TlsConfig {
   bool enabled() const { return !cert_file.empty(); }
 };
 
+/// The shipped profiles by name: "fast" and "thesis" (ProfileParams).
+std::map<std::string, Params> DefaultProfiles();
+
 /// What the server falls back to for fields a request leaves out, and the limits of a request.
 struct PlanningDefaults {
   /// The cell used when a request carries no CellDescription.
@@ -33,11 +36,15 @@ struct PlanningDefaults {
   std::uint64_t seed = 1;
   /// Parameters by profile name: "fast" and "thesis" always; `params_file` replaces the default
   /// profile's entry.
-  std::map<std::string, Params> profiles;
+  std::map<std::string, Params> profiles = DefaultProfiles();
   /// Largest cloud accepted, points (12 bytes each).
   std::uint64_t max_cloud_points = 10'000'000;
+  /// Threads each PlanPick simulates its trajectories on (RunPlanPick's `simulation_threads`);
+  /// 0 = hardware threads. Requests already run in parallel on the worker pool, so 1 keeps
+  /// workers × threads at the core count; raise it when few calls arrive at once and latency matters.
+  std::uint32_t simulation_threads = 1;
   /// Trajectory simulation (bin, tube mass and disp_max are filled per request from the cell and
-  /// the profile's planning.cost.max_displacement).
+  /// the profile's planning.cost.max_displacement; `threads` is replaced by simulation_threads).
   physics::TrajectorySimParams simulation;
 };
 
@@ -68,6 +75,10 @@ struct ServerConfig {
   /// @throws InvalidArgument naming the first bad field and its value.
   void Validate() const;
 };
+
+/// Checks a HOST:PORT address (host name, IPv4, or [IPv6]; port 0..65535).
+/// @throws InvalidArgument naming `key` and the address.
+void ValidateHostPort(const std::string& address, const std::string& key);
 
 /// The built-in default configuration as YAML (every key, with comments).
 std::string_view EmbeddedServerConfigYaml();

@@ -1,0 +1,319 @@
+#include "server/request_validation.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "core/common/errors.h"
+#include "server/proto_convert.h"
+
+namespace tubepick::server {
+namespace {
+
+// Limits of a request's cell. They equal CellConfig::Validate()'s, which PlanPick applies again:
+// a request that passes here never fails there with a core key name.
+constexpr double kMinBinSize = 0.01;  // m, each side
+constexpr double kMaxBinSize = 10.0;
+constexpr double kMinTubeRadius = 0.001;  // m
+constexpr double kMaxTubeRadius = 0.2;
+constexpr double kMaxTubeLength = 10.0;  // m
+constexpr double kMinTubeMass = 0.001;   // kg
+constexpr double kMaxTubeMass = 50.0;
+// Largest |‖q‖ − 1| of a quaternion accepted (and then normalised).
+constexpr double kQuaternionTol = 1e-3;
+
+std::string Num(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.9g", value);
+  return buffer;
+}
+
+std::string Degrees(double radians) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.1f deg", radians * 180.0 / M_PI);
+  return buffer;
+}
+
+void RequireFiniteField(double value, const std::string& field) {
+  if (!std::isfinite(value)) throw InvalidArgument(field + ": must be finite, got " + Num(value));
+}
+
+// lo < value ≤ hi (lo_open) or lo ≤ value ≤ hi.
+void RequireRange(double value, double lo, double hi, bool lo_open, const std::string& field,
+                  const std::string& unit) {
+  RequireFiniteField(value, field);
+  const bool ok = (lo_open ? value > lo : value >= lo) && value <= hi;
+  if (!ok) {
+    throw InvalidArgument(field + ": " + Num(value) + " " + unit + " is out of range " +
+                          (lo_open ? "(" : "[") + Num(lo) + ", " + Num(hi) + "] " + unit);
+  }
+}
+
+Eigen::Vector3d ToVector(const v1::Vector3& v, const std::string& field) {
+  RequireFiniteField(v.x(), field + ".x");
+  RequireFiniteField(v.y(), field + ".y");
+  RequireFiniteField(v.z(), field + ".z");
+  return {v.x(), v.y(), v.z()};
+}
+
+// A unit quaternion within kQuaternionTol, normalised; a zero or far-from-unit quaternion is an error.
+Eigen::Quaterniond ToRotation(const v1::Quaternion& q, const std::string& field) {
+  RequireFiniteField(q.x(), field + ".x");
+  RequireFiniteField(q.y(), field + ".y");
+  RequireFiniteField(q.z(), field + ".z");
+  RequireFiniteField(q.w(), field + ".w");
+  const Eigen::Quaterniond rotation(q.w(), q.x(), q.y(), q.z());
+  const double norm = rotation.norm();
+  if (!(std::abs(norm - 1.0) <= kQuaternionTol)) {
+    throw InvalidArgument(field + ": quaternion (x, y, z, w) = (" + Num(q.x()) + ", " + Num(q.y()) + ", " +
+                          Num(q.z()) + ", " + Num(q.w()) + ") is not unit length: |q| = " + Num(norm) +
+                          " (tolerance 1e-3)" + (norm == 0.0 ? "; an absent orientation is all zeros" : ""));
+  }
+  return rotation.normalized();
+}
+
+Eigen::Isometry3d ToPose(const v1::Pose& pose, const std::string& field) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = ToVector(pose.position(), field + ".position");
+  X.linear() = ToRotation(pose.orientation(), field + ".orientation").toRotationMatrix();
+  return X;
+}
+
+std::string KnownProfiles(const PlanningDefaults& defaults) {
+  std::string names;
+  for (const auto& [name, params] : defaults.profiles) names += (names.empty() ? "" : ", ") + name;
+  return names;
+}
+
+const Params& ProfileOf(const PlanningDefaults& defaults, const std::string& profile,
+                        const std::string& field) {
+  const auto it = defaults.profiles.find(profile);
+  if (it == defaults.profiles.end()) {
+    throw InvalidArgument(field + ": unknown profile '" + profile + "' (known: " + KnownProfiles(defaults) +
+                          ")");
+  }
+  return it->second;
+}
+
+LengthUnit ToUnit(int unit, LengthUnit cell_unit, const std::string& field) {
+  switch (unit) {
+    case v1::LENGTH_UNIT_UNSPECIFIED:
+      return cell_unit;
+    case v1::LENGTH_UNIT_METRE:
+      return LengthUnit::kMetre;
+    case v1::LENGTH_UNIT_MILLIMETRE:
+      return LengthUnit::kMillimetre;
+    default:
+      break;
+  }
+  throw InvalidArgument(field + ": unknown LengthUnit value " + std::to_string(unit) +
+                        " (expected LENGTH_UNIT_UNSPECIFIED = 0, LENGTH_UNIT_METRE = 1 or "
+                        "LENGTH_UNIT_MILLIMETRE = 2)");
+}
+
+// Everything of a ModelTubes / PlanPick request but the cloud bytes. `prefix` is "" for a unary
+// request and "header.request." for a stream header.
+PlanningJob ValidateContext(const v1::PlanPickRequest& request, const PlanningDefaults& defaults,
+                            const std::string& prefix) {
+  PlanningJob job;
+  job.cell = ValidateCell(request.has_cell() ? &request.cell() : nullptr, defaults, prefix + "cell");
+  job.unit = ToUnit(static_cast<int>(request.cloud().unit()), job.cell.sensor.unit, prefix + "cloud.unit");
+  const v1::PlanningOptions& options = request.options();
+  job.profile = options.profile().empty() ? defaults.profile : options.profile();
+  job.params = ProfileOf(defaults, job.profile,
+                         options.profile().empty() ? "planning.profile" : prefix + "options.profile");
+  job.seed = options.has_seed() ? options.seed() : defaults.seed;
+  job.disable_simulation = options.disable_simulation();
+  job.max_plans = options.max_plans();
+  return job;
+}
+
+// PlanPick only: the tube must fit between the open fingers (PlanPick checks it again, naming the
+// parameter; here the message names the request's field).
+void RequireTubeFitsGripper(const PlanningJob& job, bool cell_in_request, const std::string& prefix) {
+  const double opening = job.params.planning.grasps.opening_width;
+  if (!(opening > 2.0 * job.cell.tube.radius)) {
+    throw InvalidArgument(
+        (cell_in_request ? prefix + "cell.tube_radius: " : "cell.tube_radius (the server's cell): ") +
+        Num(job.cell.tube.radius) + " m: a tube of diameter " + Num(2.0 * job.cell.tube.radius) +
+        " m does not fit the gripper opening " + Num(opening) + " m (profile '" + job.profile +
+        "', planning.grasps.opening_width)");
+  }
+}
+
+// ModelTubesRequest and PlanPickRequest have the same fields (1 cloud, 2 cell, 3 options).
+v1::PlanPickRequest AsPlanPick(const v1::ModelTubesRequest& request) {
+  v1::PlanPickRequest out;
+  if (request.has_cell()) *out.mutable_cell() = request.cell();
+  if (request.has_options()) *out.mutable_options() = request.options();
+  out.mutable_cloud()->set_unit(request.cloud().unit());
+  return out;
+}
+
+}  // namespace
+
+Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::string& field) {
+  if (xyz.empty()) throw InvalidArgument(field + ": empty cloud (0 bytes); at least one point is needed");
+  if (xyz.size() % 12 != 0) {
+    throw InvalidArgument(field + ": " + std::to_string(xyz.size()) +
+                          " bytes is not a multiple of 12 (packed float32 x, y, z per point)");
+  }
+  const std::uint64_t count = xyz.size() / 12;
+  if (count > max_points) {
+    throw InvalidArgument(field + ": " + std::to_string(count) + " points exceed the limit of " +
+                          std::to_string(max_points) + " (planning.max_cloud_points)");
+  }
+  Points points(count);
+  if constexpr (std::endian::native == std::endian::little) {
+    static_assert(sizeof(Eigen::Vector3f) == 12);
+    std::memcpy(static_cast<void*>(points.data()), xyz.data(), xyz.size());
+  } else {
+    for (std::uint64_t i = 0; i < count; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        std::uint32_t bits = 0;
+        for (int b = 0; b < 4; ++b) {
+          bits |= static_cast<std::uint32_t>(static_cast<unsigned char>(xyz[12 * i + 4 * k + b])) << (8 * b);
+        }
+        points[i][k] = std::bit_cast<float>(bits);
+      }
+    }
+  }
+  return points;
+}
+
+CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults& defaults,
+                        const std::string& field) {
+  if (cell == nullptr) return defaults.cell;
+  const std::string f = field + ".";
+  CellConfig out;
+  // The request describes no sensor unit: clouds in LENGTH_UNIT_UNSPECIFIED use the server's.
+  out.sensor.unit = defaults.cell.sensor.unit;
+
+  if (!cell->has_bin_inner_size())
+    throw InvalidArgument(f + "bin_inner_size: required when the cell is given");
+  const Eigen::Vector3d size = ToVector(cell->bin_inner_size(), f + "bin_inner_size");
+  static const char* const kAxes[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    RequireRange(size[i], kMinBinSize, kMaxBinSize, false, f + "bin_inner_size." + kAxes[i], "m");
+  }
+  out.bin.inner_size = size;
+
+  if (!cell->has_sensor_pose()) throw InvalidArgument(f + "sensor_pose: required when the cell is given");
+  out.sensor.X_BinSensor = ToPose(cell->sensor_pose(), f + "sensor_pose");
+  if (!(out.sensor.X_BinSensor.translation().z() > 0.0)) {
+    throw InvalidArgument(f + "sensor_pose.position.z: the sensor must be above the bin floor (z > 0), got " +
+                          Num(out.sensor.X_BinSensor.translation().z()) + " m");
+  }
+
+  RequireRange(cell->tube_radius(), kMinTubeRadius, kMaxTubeRadius, false, f + "tube_radius", "m");
+  out.tube.radius = cell->tube_radius();
+  RequireRange(cell->tube_length(), 0.0, kMaxTubeLength, false, f + "tube_length", "m");
+  out.tube.length = cell->tube_length();
+  RequireRange(cell->tube_mass(), kMinTubeMass, kMaxTubeMass, false, f + "tube_mass", "kg");
+  out.tube.mass = cell->tube_mass();
+
+  if (!cell->has_place_pose()) throw InvalidArgument(f + "place_pose: required when the cell is given");
+  out.place.X_BinPlace = ToPose(cell->place_pose(), f + "place_pose");
+
+  try {
+    out.Validate();  // the same limits; a safety net should they ever drift apart
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(field + ": " + e.what());
+  }
+  return out;
+}
+
+PlanningJob ValidateModelTubes(const v1::ModelTubesRequest& request, const PlanningDefaults& defaults) {
+  PlanningJob job = ValidateContext(AsPlanPick(request), defaults, "");
+  job.points_Sensor = DecodeCloud(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
+  return job;
+}
+
+PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, const PlanningDefaults& defaults) {
+  PlanningJob job = ValidateContext(request, defaults, "");
+  RequireTubeFitsGripper(job, request.has_cell(), "");
+  job.points_Sensor = DecodeCloud(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
+  return job;
+}
+
+PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, std::string_view cloud_xyz,
+                             const PlanningDefaults& defaults) {
+  if (!request.cloud().xyz().empty()) {
+    throw InvalidArgument(
+        "header.request.cloud.xyz: must be empty in a stream header (the bytes follow in chunks), got " +
+        std::to_string(request.cloud().xyz().size()) + " bytes");
+  }
+  PlanningJob job = ValidateContext(request, defaults, "header.request.");
+  RequireTubeFitsGripper(job, request.has_cell(), "header.request.");
+  job.points_Sensor = DecodeCloud(cloud_xyz, defaults.max_cloud_points, "chunks (the streamed cloud)");
+  return job;
+}
+
+WrenchJob ValidateAnalyzeWrench(const v1::AnalyzeWrenchRequest& request, const PlanningDefaults& defaults) {
+  WrenchJob job;
+  if (!request.has_reference()) {
+    throw InvalidArgument("reference: required (the F/T reading with the gripper empty, before the pick)");
+  }
+  if (!request.has_current()) throw InvalidArgument("current: required (the F/T reading after the lift)");
+  job.reference.force = ToVector(request.reference().force(), "reference.force");
+  job.reference.torque = ToVector(request.reference().torque(), "reference.torque");
+  job.current.force = ToVector(request.current().force(), "current.force");
+  job.current.torque = ToVector(request.current().torque(), "current.torque");
+
+  job.tube_mass = request.has_tube_mass() ? request.tube_mass() : defaults.cell.tube.mass;
+  RequireRange(job.tube_mass, kMinTubeMass, kMaxTubeMass, false, "tube_mass", "kg");
+
+  if (!request.has_tcp_pose()) throw InvalidArgument("tcp_pose: required (X_BinTcp at lift time)");
+  job.X_BinTcp = ToPose(request.tcp_pose(), "tcp_pose");
+
+  job.params = ProfileOf(defaults, defaults.profile, "planning.profile").wrench;
+  if (request.variant() != v1::RESOLUTION_VARIANT_UNSPECIFIED) {  // else the profile's
+    const std::optional<ResolutionVariant> variant = FromProto(request.variant());
+    if (!variant) {
+      throw InvalidArgument("variant: unknown ResolutionVariant value " +
+                            std::to_string(static_cast<int>(request.variant())) +
+                            " (expected 0 = UNSPECIFIED .. 4 = JOINT_SAFE)");
+    }
+    job.params.variant = *variant;
+  }
+
+  // The vertical comes from the request's pose, not from the configured wrench.up_Tcp: the sensor
+  // axes are the TCP's (wrench.h), so the upward direction in the sensor frame is
+  // up_Tcp = R_BinTcpᵀ · z_Bin. Our grasp TCPs point z down (approach), which gives (0, 0, −1);
+  // a thesis-style sensor with z up gives (0, 0, 1). F_z of Algorithm 3 is then force · up_Tcp.
+  const Eigen::Matrix3d R_BinTcp = job.X_BinTcp.linear();
+  job.params.up_Tcp = R_BinTcp.transpose() * Eigen::Vector3d::UnitZ();
+  // With up_Tcp taken from the pose, the resolution planner's tilt guard always passes; keep its
+  // intent here: the tool axis (TCP z, up or down) must be within wrench.max_tilt of the vertical.
+  const double tilt = std::acos(std::clamp(std::abs(R_BinTcp(2, 2)), 0.0, 1.0));
+  if (tilt > job.params.max_tilt) {
+    throw InvalidArgument("tcp_pose.orientation: the TCP z axis is " + Degrees(tilt) +
+                          " from the vertical (wrench.max_tilt " + Degrees(job.params.max_tilt) +
+                          "); the gripper must be vertical at lift");
+  }
+  // A joint-safe axis fixed in the TCP frame is horizontal for the configured up_Tcp; re-project it
+  // onto the horizontal plane of this pose (it differs by at most max_tilt).
+  if (job.params.joint_safe_frame == JointSafeFrame::kTcp) {
+    const Eigen::Vector3d up = job.params.up_Tcp;
+    Eigen::Vector3d axis = job.params.joint_safe_axis.normalized();
+    axis -= axis.dot(up) * up;
+    if (axis.norm() < 1e-6) {
+      throw InvalidArgument("tcp_pose.orientation: the vertical is parallel to wrench.joint_safe_axis");
+    }
+    job.params.joint_safe_axis = axis.normalized();
+  }
+
+  const double weight = job.tube_mass * job.params.gravity;
+  if (!(job.params.force_tolerance < weight)) {
+    throw InvalidArgument("tube_mass: " + Num(job.tube_mass) + " kg weighs " + Num(weight) +
+                          " N, not more than wrench.force_tolerance " + Num(job.params.force_tolerance) +
+                          " N: one tube could not be told from none" +
+                          (request.has_tube_mass() ? "" : " (the server's cell tube mass)"));
+  }
+  job.params.Validate();
+  return job;
+}
+
+}  // namespace tubepick::server
