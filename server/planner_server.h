@@ -1,6 +1,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 
 #include "server/server_config.h"
@@ -37,6 +38,9 @@ class PlannerServer {
 
   /// Calls answered so far (any status), for tests and the metrics.
   std::uint64_t calls_served() const;
+  /// Planning workers running a call right now (tests check that a cancelled call frees its worker).
+  /// A worker counts as busy until its job has returned, i.e. a moment after the client got the answer.
+  std::uint32_t workers_busy() const;
 
  private:
   struct Impl;

@@ -1,0 +1,216 @@
+#include "server/planner_server.h"
+
+#include <fmt/format.h>
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <spdlog/spdlog.h>
+
+#include <climits>
+#include <condition_variable>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "server/metrics.h"
+#include "server/metrics_http.h"
+#include "server/planner_service.h"
+#include "server/worker_pool.h"
+
+namespace tubepick::server {
+namespace {
+
+constexpr const char* kServiceName = "tubepick.v1.PickPlannerService";
+
+std::string ReadPem(const std::string& path, const char* what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("tls.{}: cannot read '{}'", what, path));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::shared_ptr<grpc::ServerCredentials> MakeCredentials(const TlsConfig& tls) {
+  if (!tls.enabled()) return grpc::InsecureServerCredentials();
+  grpc_ssl_client_certificate_request_type request = GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE;
+  if (tls.require_client_cert) {
+    request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
+  } else if (!tls.client_ca_file.empty()) {
+    request = GRPC_SSL_REQUEST_CLIENT_CERTIFICATE_AND_VERIFY;
+  }
+  grpc::SslServerCredentialsOptions options(request);
+  if (!tls.client_ca_file.empty()) options.pem_root_certs = ReadPem(tls.client_ca_file, "client_ca_file");
+  options.pem_key_cert_pairs.push_back(
+      {ReadPem(tls.key_file, "key_file"), ReadPem(tls.cert_file, "cert_file")});
+  return grpc::SslServerCredentials(options);
+}
+
+std::uint32_t WorkerCount(const ServerConfig& config) {
+  if (config.workers > 0) return config.workers;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// "::" → "[::]", so that "HOST:PORT" stays parseable.
+std::string HostForLog(const std::string& host) {
+  return host.find(':') == std::string::npos ? host : "[" + host + "]";
+}
+
+int ClampToInt(std::uint64_t v) {
+  return v > static_cast<std::uint64_t>(INT_MAX) ? INT_MAX : static_cast<int>(v);
+}
+
+}  // namespace
+
+struct PlannerServer::Impl {
+  enum class State { kCreated, kRunning, kStopping, kStopped };
+
+  explicit Impl(ServerConfig c) : config(std::move(c)) {}
+
+  ServerConfig config;
+  std::unique_ptr<WorkerPool> pool;
+  std::unique_ptr<Metrics> metrics;
+  std::unique_ptr<PlannerService> service;
+  std::unique_ptr<grpc::Server> server;
+  std::unique_ptr<MetricsHttpServer> http;
+  int port = 0;
+
+  std::mutex mu;
+  std::condition_variable cv;
+  State state = State::kCreated;
+};
+
+PlannerServer::PlannerServer(ServerConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {
+  impl_->config.Validate();
+}
+
+PlannerServer::~PlannerServer() { Shutdown(std::chrono::milliseconds(0)); }
+
+void PlannerServer::Start() {
+  Impl& m = *impl_;
+  {
+    std::lock_guard lock(m.mu);
+    if (m.state != Impl::State::kCreated) throw std::runtime_error("PlannerServer::Start: already started");
+  }
+  const ServerConfig& config = m.config;
+  // Both are process-wide switches read when a server is built.
+  static std::once_flag global_setup;
+  std::call_once(global_setup, [] {
+    grpc::EnableDefaultHealthCheckService(true);
+    grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  });
+
+  m.metrics = std::make_unique<Metrics>();
+  m.pool = std::make_unique<WorkerPool>(WorkerCount(config), config.queue_capacity);
+  m.service = std::make_unique<PlannerService>(config, m.pool.get(), m.metrics.get());
+
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(config.address, MakeCredentials(config.tls), &m.port);
+  builder.SetMaxReceiveMessageSize(ClampToInt(config.max_message_bytes));
+  builder.SetMaxSendMessageSize(ClampToInt(config.max_message_bytes));
+  // A second server on a fixed, busy port must fail rather than share it silently.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.RegisterService(m.service.get());
+  m.server = builder.BuildAndStart();
+  if (m.server == nullptr || m.port == 0) {
+    m.server.reset();
+    m.pool->Stop();
+    throw std::runtime_error(fmt::format("cannot listen on {} (address in use or invalid?)", config.address));
+  }
+  grpc::HealthCheckServiceInterface* health = m.server->GetHealthCheckService();
+  health->SetServingStatus("", true);
+  health->SetServingStatus(kServiceName, true);
+
+  if (!config.metrics_address.empty()) {
+    try {
+      m.http = std::make_unique<MetricsHttpServer>(
+          config.metrics_address, [&m] { return m.metrics->RenderPrometheus(m.pool->load()); });
+    } catch (...) {
+      m.server->Shutdown(std::chrono::system_clock::now());
+      m.server.reset();
+      m.pool->Stop();
+      throw;
+    }
+  }
+  {
+    std::lock_guard lock(m.mu);
+    m.state = Impl::State::kRunning;
+  }
+  const std::string host = HostForLog(SplitHostPort(config.address, "address").first);
+  spdlog::info("listening on {}:{} ({}, {} workers, queue {}, max message {} bytes)", host, m.port,
+               config.tls.enabled() ? (config.tls.require_client_cert ? "mutual TLS" : "TLS") : "plaintext",
+               m.pool->workers(), config.queue_capacity, config.max_message_bytes);
+  if (m.http) {
+    spdlog::info("metrics on http://{}:{}/metrics",
+                 HostForLog(SplitHostPort(config.metrics_address, "metrics_address").first), m.http->port());
+  }
+}
+
+int PlannerServer::port() const { return impl_->port; }
+
+int PlannerServer::metrics_port() const { return impl_->http ? impl_->http->port() : 0; }
+
+void PlannerServer::Shutdown(std::chrono::milliseconds grace) {
+  Impl& m = *impl_;
+  {
+    std::unique_lock lock(m.mu);
+    if (m.state == Impl::State::kStopped) return;
+    if (m.state == Impl::State::kStopping) {
+      m.cv.wait(lock, [&] { return m.state == Impl::State::kStopped; });
+      return;
+    }
+    if (m.state == Impl::State::kCreated) {
+      m.state = Impl::State::kStopped;
+      m.cv.notify_all();
+      return;
+    }
+    m.state = Impl::State::kStopping;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  spdlog::info("shutting down: {} calls in flight, grace {} ms", m.service->calls_in_flight(), grace.count());
+  // Load balancers and health probes see NOT_SERVING first.
+  m.server->GetHealthCheckService()->SetServingStatus(false);
+
+  // gRPC refuses new calls at once and cancels the remaining ones at the deadline (their OnCancel
+  // stops the tokens). The watchdog also stops every token then, in case a call is between states.
+  const auto deadline = std::chrono::system_clock::now() + grace;
+  std::mutex watchdog_mu;
+  std::condition_variable watchdog_cv;
+  bool drained = false;
+  std::thread watchdog([&] {
+    std::unique_lock lock(watchdog_mu);
+    if (!watchdog_cv.wait_until(lock, deadline, [&] { return drained; })) m.service->CancelAll();
+  });
+  m.server->Shutdown(deadline);
+  {
+    std::lock_guard lock(watchdog_mu);
+    drained = true;
+  }
+  watchdog_cv.notify_all();
+  watchdog.join();
+  m.service->CancelAll();
+  m.pool->Stop();
+  if (m.http) m.http->Stop();
+  spdlog::info("shut down after {:.0f} ms; {} calls served",
+               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count(),
+               m.service->calls_served());
+  {
+    std::lock_guard lock(m.mu);
+    m.state = Impl::State::kStopped;
+  }
+  m.cv.notify_all();
+}
+
+void PlannerServer::Wait() {
+  std::unique_lock lock(impl_->mu);
+  impl_->cv.wait(lock, [&] { return impl_->state == Impl::State::kStopped; });
+}
+
+std::uint64_t PlannerServer::calls_served() const {
+  return impl_->service ? impl_->service->calls_served() : 0;
+}
+
+std::uint32_t PlannerServer::workers_busy() const { return impl_->pool ? impl_->pool->load().busy : 0; }
+
+}  // namespace tubepick::server

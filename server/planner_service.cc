@@ -1,0 +1,406 @@
+#include "server/planner_service.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <optional>
+#include <random>
+#include <utility>
+
+#include "core/common/errors.h"
+#include "server/cloud_stream.h"
+#include "server/planning_jobs.h"
+#include "server/request_log.h"
+#include "server/request_validation.h"
+
+namespace tubepick::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+const char* StatusCodeName(grpc::StatusCode code) {
+  switch (code) {
+    case grpc::StatusCode::OK:
+      return "OK";
+    case grpc::StatusCode::CANCELLED:
+      return "CANCELLED";
+    case grpc::StatusCode::UNKNOWN:
+      return "UNKNOWN";
+    case grpc::StatusCode::INVALID_ARGUMENT:
+      return "INVALID_ARGUMENT";
+    case grpc::StatusCode::DEADLINE_EXCEEDED:
+      return "DEADLINE_EXCEEDED";
+    case grpc::StatusCode::NOT_FOUND:
+      return "NOT_FOUND";
+    case grpc::StatusCode::ALREADY_EXISTS:
+      return "ALREADY_EXISTS";
+    case grpc::StatusCode::PERMISSION_DENIED:
+      return "PERMISSION_DENIED";
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+      return "RESOURCE_EXHAUSTED";
+    case grpc::StatusCode::FAILED_PRECONDITION:
+      return "FAILED_PRECONDITION";
+    case grpc::StatusCode::ABORTED:
+      return "ABORTED";
+    case grpc::StatusCode::OUT_OF_RANGE:
+      return "OUT_OF_RANGE";
+    case grpc::StatusCode::UNIMPLEMENTED:
+      return "UNIMPLEMENTED";
+    case grpc::StatusCode::INTERNAL:
+      return "INTERNAL";
+    case grpc::StatusCode::UNAVAILABLE:
+      return "UNAVAILABLE";
+    case grpc::StatusCode::DATA_LOSS:
+      return "DATA_LOSS";
+    case grpc::StatusCode::UNAUTHENTICATED:
+      return "UNAUTHENTICATED";
+    default:
+      return "UNKNOWN";
+  }
+}
+
+// A client's x-request-id is kept when it is 1..128 printable ASCII characters without spaces
+// (it goes into log lines and metadata verbatim); anything else gets a fresh id.
+bool SaneRequestId(std::string_view id) {
+  if (id.empty() || id.size() > 128) return false;
+  return std::all_of(id.begin(), id.end(),
+                     [](char c) { return c > 0x20 && c < 0x7f && c != '"' && c != '\\'; });
+}
+
+// 16 random hex digits. Request ids need uniqueness, not reproducibility.
+std::string NewRequestId() {
+  thread_local std::mt19937_64 rng{std::random_device{}() ^
+                                   static_cast<std::uint64_t>(Clock::now().time_since_epoch().count())};
+  return fmt::format("{:016x}", rng());
+}
+
+std::string RequestIdOf(const grpc::CallbackServerContext& context) {
+  const auto& metadata = context.client_metadata();
+  const auto it = metadata.find("x-request-id");
+  if (it != metadata.end()) {
+    const std::string_view id(it->second.data(), it->second.size());
+    if (SaneRequestId(id)) return std::string(id);
+  }
+  return NewRequestId();
+}
+
+// The call's deadline on the steady clock; nullopt for none (gRPC reports "infinite" as max()).
+std::optional<Clock::time_point> SteadyDeadline(const grpc::CallbackServerContext& context) {
+  const auto deadline = context.deadline();
+  if (deadline >= std::chrono::system_clock::time_point::max() - std::chrono::hours(24 * 365))
+    return std::nullopt;
+  return Clock::now() +
+         std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now());
+}
+
+}  // namespace
+
+/// Bookkeeping shared by the unary and the stream reactors.
+struct PlannerService::CallState {
+  CallState(grpc::CallbackServerContext* context, const char* rpc) : arrived(Clock::now()) {
+    record.rpc = rpc;
+    record.request_id = RequestIdOf(*context);
+    record.peer = context->peer();
+    deadline = SteadyDeadline(*context);
+    if (deadline) token.set_deadline(*deadline);
+    context->AddInitialMetadata("x-request-id", record.request_id);
+  }
+
+  void MarkCancelled() {
+    std::int64_t expected = 0;
+    cancelled_at.compare_exchange_strong(expected, Clock::now().time_since_epoch().count());
+    token.RequestStop();
+  }
+
+  /// When the call was asked to stop: the cancel, or the deadline if that came first.
+  std::optional<Clock::time_point> StopTime() const {
+    std::optional<Clock::time_point> t;
+    if (const std::int64_t ns = cancelled_at.load(); ns != 0) t = Clock::time_point(Clock::duration(ns));
+    if (deadline && Clock::now() >= *deadline && (!t || *deadline < *t)) t = deadline;
+    return t;
+  }
+
+  /// CANCELLED, or DEADLINE_EXCEEDED when the deadline has passed (gRPC also cancels a call at its
+  /// deadline, so the token may say "cancelled" for an expired call).
+  grpc::Status CancelledStatus(const std::string& what) const {
+    if (!token.deadline_passed()) return {grpc::StatusCode::CANCELLED, what};
+    const std::string_view cancelled = "cancelled ";
+    return {grpc::StatusCode::DEADLINE_EXCEEDED,
+            what.rfind(cancelled, 0) == 0 ? "deadline exceeded " + what.substr(cancelled.size()) : what};
+  }
+
+  const Clock::time_point arrived;
+  std::optional<Clock::time_point> deadline;
+  StopToken token;
+  std::atomic<std::int64_t> cancelled_at{0};  // steady ns of OnCancel; 0 = not cancelled
+  bool ran = false;                           // reached a worker and started
+  CallRecord record;
+};
+
+class PlannerService::UnaryCall final : public grpc::ServerUnaryReactor {
+ public:
+  UnaryCall(PlannerService* service, grpc::CallbackServerContext* context, const char* rpc)
+      : service_(service), state_(context, rpc) {
+    service_->Register(&state_.token);
+  }
+  CallState& state() { return state_; }
+  /// Logs, counts and finishes the call. `this` may be deleted as soon as it returns.
+  void Answer(grpc::Status status) { Finish(service_->Conclude(state_, std::move(status))); }
+
+  void OnCancel() override { state_.MarkCancelled(); }
+  void OnDone() override {
+    service_->Unregister(&state_.token);
+    delete this;
+  }
+
+ private:
+  PlannerService* service_;
+  CallState state_;
+};
+
+class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::PlanPickStreamRequest> {
+ public:
+  StreamCall(PlannerService* service, grpc::CallbackServerContext* context,
+             v1::PlanPickStreamResponse* response)
+      : service_(service),
+        state_(context, "PlanPickStream"),
+        response_(response),
+        assembler_(service->config_.max_stream_bytes) {
+    service_->Register(&state_.token);
+    StartRead(&message_);
+  }
+
+  void OnReadDone(bool ok) override {
+    if (!ok) {
+      UploadEnded();
+      return;
+    }
+    try {
+      const bool had_header = assembler_.has_header();
+      const std::uint64_t announced = message_.has_header() ? message_.header().total_bytes() : 0;
+      assembler_.Add(message_);
+      if (!had_header) {  // Add accepts nothing but a header first
+        state_.record.points = announced / 12;
+        std::optional<WorkerPool::Reservation> slot = service_->pool_->TryReserve();
+        if (!slot) {
+          Answer(service_->Rejected(state_));
+          return;
+        }
+        reservation_ = std::move(*slot);
+      }
+    } catch (const InvalidArgument& e) {
+      Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what()));
+      return;
+    }
+    message_.Clear();
+    StartRead(&message_);
+  }
+
+  void OnCancel() override { state_.MarkCancelled(); }
+  void OnDone() override {
+    service_->Unregister(&state_.token);
+    delete this;
+  }
+
+ private:
+  // The client half-closed (or the call broke): run the plan on the reserved slot.
+  void UploadEnded() {
+    if (state_.token.should_stop()) {
+      Answer(state_.CancelledStatus("stopped while the cloud was uploading"));
+      return;
+    }
+    if (!assembler_.has_header()) {
+      Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                          "PlanPickStream ended before its header: the first message must be a header"));
+      return;
+    }
+    const Clock::time_point enqueued = Clock::now();
+    const WorkerPool::Admission admission =
+        service_->pool_->Submit(std::move(reservation_), [this, enqueued] {
+          const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
+            PlanningJob job;
+            {
+              const std::string cloud = assembler_.Finish();  // checks chunks, size, CRC
+              job = ValidatePlanPick(assembler_.request(), cloud, service_->config_.planning);
+            }
+            state_.record.points = job.points_Sensor.size();
+            *response_->mutable_response() =
+                RunPlanPick(job, service_->config_.planning,
+                            static_cast<int>(service_->config_.planning.simulation_threads), &state_.token);
+            state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
+            state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
+          });
+          Answer(status);
+        });
+    if (admission != WorkerPool::Admission::kAdmitted)
+      Answer(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
+  }
+
+  void Answer(grpc::Status status) {
+    reservation_.Release();
+    Finish(service_->Conclude(state_, std::move(status)));
+  }
+
+  PlannerService* service_;
+  CallState state_;
+  v1::PlanPickStreamResponse* response_;
+  v1::PlanPickStreamRequest message_;
+  CloudStreamAssembler assembler_;
+  WorkerPool::Reservation reservation_;
+};
+
+PlannerService::PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics)
+    : config_(std::move(config)), pool_(pool), metrics_(metrics) {}
+
+void PlannerService::Register(StopToken* token) {
+  std::lock_guard lock(calls_mu_);
+  active_.insert(token);
+}
+
+void PlannerService::Unregister(StopToken* token) {
+  std::lock_guard lock(calls_mu_);
+  active_.erase(token);
+}
+
+void PlannerService::CancelAll() {
+  std::lock_guard lock(calls_mu_);
+  for (StopToken* token : active_) token->RequestStop();
+}
+
+std::size_t PlannerService::calls_in_flight() const {
+  std::lock_guard lock(calls_mu_);
+  return active_.size();
+}
+
+grpc::Status PlannerService::Rejected(const CallState&) {
+  metrics_->RecordRejected();
+  const PoolLoad load = pool_->load();
+  return {grpc::StatusCode::RESOURCE_EXHAUSTED,
+          fmt::format("planning queue full: {} running, {} queued; retry later", load.busy,
+                      load.queued + load.reserved)};
+}
+
+grpc::Status PlannerService::Conclude(CallState& call, grpc::Status status) {
+  const Clock::time_point now = Clock::now();
+  CallRecord& r = call.record;
+  r.code = StatusCodeName(status.error_code());
+  r.message = status.error_message();
+  r.total_ms = Ms(now - call.arrived);
+  if (call.ran && !status.ok()) {
+    if (const std::optional<Clock::time_point> stop = call.StopTime())
+      r.stop_ms = std::max(0.0, Ms(now - *stop));
+  }
+  if (!status.ok()) {
+    r.tubes = 0;
+    r.plans = 0;
+  }
+  metrics_->RecordCall(r.rpc, r.code, r.total_ms / 1000.0);
+  LogCall(r);
+  served_.fetch_add(1);
+  return status;
+}
+
+grpc::Status PlannerService::RunOnWorker(CallState& call, Clock::time_point enqueued,
+                                         const std::function<void()>& body) {
+  const Clock::time_point started = Clock::now();
+  call.record.queue_ms = Ms(started - enqueued);
+  if (call.token.should_stop()) {
+    metrics_->RecordExpiredInQueue();
+    return call.CancelledStatus("stopped while queued for a planning worker; not run");
+  }
+  call.ran = true;
+  grpc::Status status;
+  try {
+    body();
+  } catch (const Cancelled& e) {
+    status = call.CancelledStatus(e.what());
+  } catch (const InvalidArgument& e) {
+    status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const std::exception& e) {
+    spdlog::error("{} {}: internal error: {}", call.record.rpc, call.record.request_id, e.what());
+    status = grpc::Status(grpc::StatusCode::INTERNAL,
+                          fmt::format("internal error (request id {})", call.record.request_id));
+  } catch (...) {
+    spdlog::error("{} {}: internal error: unknown exception", call.record.rpc, call.record.request_id);
+    status = grpc::Status(grpc::StatusCode::INTERNAL,
+                          fmt::format("internal error (request id {})", call.record.request_id));
+  }
+  call.record.run_ms = Ms(Clock::now() - started);
+  return status;
+}
+
+grpc::ServerUnaryReactor* PlannerService::StartPlanning(grpc::CallbackServerContext* context, const char* rpc,
+                                                        std::uint64_t points,
+                                                        std::function<void(CallState&)> body) {
+  auto* call = new UnaryCall(this, context, rpc);
+  call->state().record.points = points;
+  const Clock::time_point enqueued = Clock::now();
+  const WorkerPool::Admission admission = pool_->TrySubmit([this, call, enqueued, body = std::move(body)] {
+    CallState& state = call->state();
+    call->Answer(RunOnWorker(state, enqueued, [&] { body(state); }));
+  });
+  // On admission the worker may already have answered; the reactor lives until gRPC has bound it.
+  if (admission == WorkerPool::Admission::kFull) {
+    call->Answer(Rejected(call->state()));
+  } else if (admission == WorkerPool::Admission::kStopped) {
+    call->Answer(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
+  }
+  return call;
+}
+
+grpc::ServerUnaryReactor* PlannerService::ModelTubes(grpc::CallbackServerContext* context,
+                                                     const v1::ModelTubesRequest* request,
+                                                     v1::ModelTubesResponse* response) {
+  return StartPlanning(context, "ModelTubes", request->cloud().xyz().size() / 12,
+                       [this, request, response](CallState& call) {
+                         const PlanningJob job = ValidateModelTubes(*request, config_.planning);
+                         *response = RunModelTubes(job, &call.token);
+                         call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
+                       });
+}
+
+grpc::ServerUnaryReactor* PlannerService::PlanPick(grpc::CallbackServerContext* context,
+                                                   const v1::PlanPickRequest* request,
+                                                   v1::PlanPickResponse* response) {
+  return StartPlanning(
+      context, "PlanPick", request->cloud().xyz().size() / 12, [this, request, response](CallState& call) {
+        const PlanningJob job = ValidatePlanPick(*request, config_.planning);
+        *response = RunPlanPick(job, config_.planning, static_cast<int>(config_.planning.simulation_threads),
+                                &call.token);
+        call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
+        call.record.plans = static_cast<std::uint32_t>(response->plans_size());
+      });
+}
+
+grpc::ServerReadReactor<v1::PlanPickStreamRequest>* PlannerService::PlanPickStream(
+    grpc::CallbackServerContext* context, v1::PlanPickStreamResponse* response) {
+  return new StreamCall(this, context, response);
+}
+
+grpc::ServerUnaryReactor* PlannerService::AnalyzeWrench(grpc::CallbackServerContext* context,
+                                                        const v1::AnalyzeWrenchRequest* request,
+                                                        v1::AnalyzeWrenchResponse* response) {
+  // Microseconds of arithmetic: answered inline, never queued behind plans.
+  auto* call = new UnaryCall(this, context, "AnalyzeWrench");
+  call->state().ran = true;
+  const Clock::time_point started = Clock::now();
+  grpc::Status status;
+  try {
+    const WrenchJob job = ValidateAnalyzeWrench(*request, config_.planning);
+    *response = RunAnalyzeWrench(job);
+  } catch (const InvalidArgument& e) {
+    status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const std::exception& e) {
+    spdlog::error("AnalyzeWrench {}: internal error: {}", call->state().record.request_id, e.what());
+    status = grpc::Status(grpc::StatusCode::INTERNAL,
+                          fmt::format("internal error (request id {})", call->state().record.request_id));
+  }
+  call->state().record.run_ms = Ms(Clock::now() - started);
+  call->Answer(std::move(status));
+  return call;
+}
+
+}  // namespace tubepick::server

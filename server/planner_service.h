@@ -1,0 +1,78 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include "core/common/stop_token.h"
+#include "server/metrics.h"
+#include "server/server_config.h"
+#include "server/worker_pool.h"
+#include "tubepick/v1/service.grpc.pb.h"
+
+namespace tubepick::server {
+
+/// PickPlannerService on gRPC's callback API. Each call:
+/// - gets a request id (the client's `x-request-id` metadata when it is sane, else a generated
+///   one), echoed in the initial metadata and written in its log line (LogCall) and metrics;
+/// - gets a StopToken carrying the call's deadline, stopped by ServerUnaryReactor::OnCancel
+///   (client cancel, deadline, shutdown), which modeling and simulation poll;
+/// - ModelTubes / PlanPick / PlanPickStream are admitted to the WorkerPool or refused at once with
+///   RESOURCE_EXHAUSTED; a PlanPickStream takes its slot when its header arrives (so uploads in
+///   progress count against admission and memory) and gives it back when it fails. Validation and
+///   work run on the worker; a call whose deadline passed (or that was cancelled) while queued is
+///   dropped without running. AnalyzeWrench is microseconds of arithmetic and runs inline;
+/// - errors map as: InvalidArgument → INVALID_ARGUMENT (its message), Cancelled → CANCELLED or
+///   DEADLINE_EXCEEDED, anything else → INTERNAL (logged with the request id).
+class PlannerService final : public v1::PickPlannerService::CallbackService {
+ public:
+  /// `pool` and `metrics` must outlive the service.
+  PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics);
+
+  grpc::ServerUnaryReactor* ModelTubes(grpc::CallbackServerContext* context,
+                                       const v1::ModelTubesRequest* request,
+                                       v1::ModelTubesResponse* response) override;
+  grpc::ServerUnaryReactor* PlanPick(grpc::CallbackServerContext* context, const v1::PlanPickRequest* request,
+                                     v1::PlanPickResponse* response) override;
+  grpc::ServerReadReactor<v1::PlanPickStreamRequest>* PlanPickStream(
+      grpc::CallbackServerContext* context, v1::PlanPickStreamResponse* response) override;
+  grpc::ServerUnaryReactor* AnalyzeWrench(grpc::CallbackServerContext* context,
+                                          const v1::AnalyzeWrenchRequest* request,
+                                          v1::AnalyzeWrenchResponse* response) override;
+
+  /// Stops every call in progress (their workers throw Cancelled at the next poll). Shutdown uses
+  /// it when the grace period is over.
+  void CancelAll();
+  /// Calls whose reactor has not completed yet.
+  std::size_t calls_in_flight() const;
+  /// Calls answered so far, any status.
+  std::uint64_t calls_served() const { return served_.load(); }
+
+ private:
+  struct CallState;
+  class UnaryCall;
+  class StreamCall;
+
+  /// Queues `body` (validation and work, filling the response and the record) for a unary call.
+  grpc::ServerUnaryReactor* StartPlanning(grpc::CallbackServerContext* context, const char* rpc,
+                                          std::uint64_t points, std::function<void(CallState&)> body);
+  /// The worker side of every planning call: drops expired calls, runs `body`, maps exceptions.
+  grpc::Status RunOnWorker(CallState& call, std::chrono::steady_clock::time_point enqueued,
+                           const std::function<void()>& body);
+  grpc::Status Rejected(const CallState& call);
+  grpc::Status Conclude(CallState& call, grpc::Status status);
+  void Register(StopToken* token);
+  void Unregister(StopToken* token);
+
+  const ServerConfig config_;
+  WorkerPool* pool_;
+  Metrics* metrics_;
+  mutable std::mutex calls_mu_;
+  std::set<StopToken*> active_;
+  std::atomic<std::uint64_t> served_{0};
+};
+
+}  // namespace tubepick::server

@@ -1,0 +1,207 @@
+// PlanPickStream against a real in-process server: chunks in order, out of order, truncated,
+// duplicated, corrupted, before the header; and admission of uploads in progress.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "server/cloud_stream.h"
+#include "tests/service_test_support.h"
+
+namespace tubepick::service_test {
+namespace {
+
+using ::testing::HasSubstr;
+
+/// The messages of one stream: header first, then the chunks in index order.
+std::vector<v1::PlanPickStreamRequest> StreamMessages(const std::string& xyz, std::size_t chunk_bytes) {
+  std::vector<v1::PlanPickStreamRequest> messages(1);
+  v1::PlanPickStreamHeader* header = messages[0].mutable_header();
+  *header->mutable_request() = PlanRequest("");
+  header->set_total_bytes(xyz.size());
+  header->set_chunk_count(static_cast<std::uint32_t>((xyz.size() + chunk_bytes - 1) / chunk_bytes));
+  header->set_crc32c(server::Crc32c(xyz));
+  for (std::uint32_t i = 0; i * chunk_bytes < xyz.size(); ++i) {
+    v1::PlanPickStreamRequest m;
+    m.mutable_chunk()->set_index(i);
+    m.mutable_chunk()->set_data(xyz.substr(i * chunk_bytes, chunk_bytes));
+    messages.push_back(std::move(m));
+  }
+  return messages;
+}
+
+struct StreamResult {
+  grpc::Status status;
+  v1::PlanPickStreamResponse response;
+};
+
+StreamResult SendStream(v1::PickPlannerService::Stub& stub,
+                        const std::vector<v1::PlanPickStreamRequest>& messages) {
+  grpc::ClientContext context;
+  SetTimeout(&context, std::chrono::seconds(60));
+  StreamResult result;
+  std::unique_ptr<grpc::ClientWriter<v1::PlanPickStreamRequest>> writer =
+      stub.PlanPickStream(&context, &result.response);
+  for (const auto& m : messages) {
+    if (!writer->Write(m)) break;  // the server already answered (an error)
+  }
+  writer->WritesDone();
+  result.status = writer->Finish();
+  return result;
+}
+
+class ServiceStream : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { server_ = new TestServer(TestConfig(2, 8)); }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  static TestServer* server_;
+};
+
+TestServer* ServiceStream::server_ = nullptr;
+
+// ~375 kB of cloud in 64 kB chunks: 6 chunks.
+constexpr std::size_t kChunk = 64 * 1024;
+
+TEST_F(ServiceStream, InOrderAnswersLikePlanPick) {
+  const auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  ASSERT_EQ(messages.size(), 7u);
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  ASSERT_TRUE(streamed.status.ok()) << streamed.status.error_message();
+  const v1::PlanPickResponse& r = streamed.response.response();
+  EXPECT_EQ(r.tubes_size(), 3);
+  EXPECT_EQ(r.modeling().input_points(), ThreeTubeCloud().size() / 12);
+
+  grpc::ClientContext context;
+  v1::PlanPickResponse unary;
+  ASSERT_TRUE(server_->stub().PlanPick(&context, PlanRequest(ThreeTubeCloud()), &unary).ok());
+  ASSERT_EQ(r.plans_size(), unary.plans_size());
+  ASSERT_GT(r.plans_size(), 0);
+  for (int i = 0; i < r.plans_size(); ++i) {
+    EXPECT_EQ(r.plans(i).tube_id(), unary.plans(i).tube_id());
+    EXPECT_EQ(r.plans(i).cost().total(), unary.plans(i).cost().total());
+  }
+}
+
+TEST_F(ServiceStream, OutOfOrderChunksAreJoinedByIndex) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  std::reverse(messages.begin() + 1, messages.end());
+  std::swap(messages[2], messages[4]);
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  ASSERT_TRUE(streamed.status.ok()) << streamed.status.error_message();
+  EXPECT_EQ(streamed.response.response().tubes_size(), 3);
+  EXPECT_GT(streamed.response.response().plans_size(), 0);
+}
+
+TEST_F(ServiceStream, AMissingChunkIsInvalid) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  messages.erase(messages.begin() + 3);  // chunk 2
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("missing 2"));
+}
+
+TEST_F(ServiceStream, ADuplicateChunkIsInvalid) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  messages.insert(messages.begin() + 3, messages[2]);
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("duplicate"));
+}
+
+TEST_F(ServiceStream, ABadChecksumIsInvalid) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  std::string& data = *messages[3].mutable_chunk()->mutable_data();
+  data[100] = static_cast<char>(data[100] ^ 0x01);  // one flipped bit
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("crc32c mismatch"));
+}
+
+TEST_F(ServiceStream, AChunkBeforeTheHeaderIsInvalid) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  std::swap(messages[0], messages[1]);
+  const StreamResult streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("header"));
+}
+
+TEST_F(ServiceStream, AnEmptyStreamIsInvalid) {
+  const StreamResult streamed = SendStream(server_->stub(), {});
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("header"));
+}
+
+TEST_F(ServiceStream, HeaderValidationNamesTheField) {
+  auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  messages[0].mutable_header()->set_total_bytes(ThreeTubeCloud().size() + 1);
+  StreamResult streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("header.total_bytes"));
+
+  messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  messages[0].mutable_header()->mutable_request()->mutable_options()->set_profile("turbo");
+  streamed = SendStream(server_->stub(), messages);
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("header.request.options.profile"));
+}
+
+// Waits until the server counts `n` uploads in progress (the tubepick_stream_uploads gauge).
+void WaitForUploads(const TestServer& server, double n) {
+  const auto reached = WaitFor(
+      [&] { return MetricValue(ScrapeMetrics(server.metrics_port()), "tubepick_stream_uploads") == n; },
+      std::chrono::seconds(10));
+  ASSERT_TRUE(reached) << "uploads never reached " << n;
+}
+
+TEST(ServiceStreamAdmission, UploadsInProgressCountAgainstAdmissionAndErrorsReleaseTheirSlot) {
+  TestServer server(TestConfig(1, 1));  // room for 2 admitted calls
+  const auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  auto open = [&](grpc::ClientContext* context, v1::PlanPickStreamResponse* response) {
+    SetTimeout(context, std::chrono::seconds(60));
+    auto writer = server.stub().PlanPickStream(context, response);
+    EXPECT_TRUE(writer->Write(messages[0]));  // header only
+    return writer;
+  };
+  grpc::ClientContext ca, cb, cc;
+  v1::PlanPickStreamResponse ra, rb, rc;
+  auto a = open(&ca, &ra);
+  WaitForUploads(server, 1);
+  auto b = open(&cb, &rb);
+  WaitForUploads(server, 2);
+  // The third header finds both slots taken by uploads that have sent no chunk yet.
+  auto c = open(&cc, &rc);
+  c->WritesDone();
+  const grpc::Status rejected = c->Finish();
+  EXPECT_EQ(rejected.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(rejected.error_message(), HasSubstr("planning queue full: 0 running, 2 queued"));
+
+  // A fails (duplicate chunk) and gives its slot back: a new stream D is admitted.
+  a->Write(messages[1]);
+  a->Write(messages[1]);
+  a->WritesDone();
+  EXPECT_EQ(a->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  WaitForUploads(server, 1);
+  grpc::ClientContext cd;
+  v1::PlanPickStreamResponse rd;
+  auto d = open(&cd, &rd);
+  WaitForUploads(server, 2);
+  for (auto* writer : {b.get(), d.get()}) {
+    for (std::size_t i = 1; i < messages.size(); ++i) ASSERT_TRUE(writer->Write(messages[i]));
+    writer->WritesDone();
+  }
+  const grpc::Status sb = b->Finish(), sd = d->Finish();
+  EXPECT_TRUE(sb.ok()) << sb.error_message();
+  EXPECT_TRUE(sd.ok()) << sd.error_message();
+  EXPECT_EQ(rb.response().tubes_size(), 3);
+  EXPECT_EQ(rd.response().tubes_size(), 3);
+  const std::string metrics = ScrapeMetrics(server.metrics_port());
+  EXPECT_EQ(MetricValue(metrics, "tubepick_rejected_total"), 1.0);
+  EXPECT_EQ(MetricValue(metrics, "tubepick_stream_uploads"), 0.0);
+  EXPECT_EQ(MetricValue(metrics, "tubepick_rpc_requests_total{method=\"PlanPickStream\",code=\"OK\"}"), 2.0);
+}
+
+}  // namespace
+}  // namespace tubepick::service_test
