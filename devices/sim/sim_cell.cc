@@ -1,0 +1,180 @@
+#include "devices/sim/sim_cell.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+#include "devices/sim/sim_devices.h"
+#include "physics/scene_generator.h"
+#include "physics/seeds.h"
+
+namespace tubepick::devices::sim {
+namespace {
+
+/// Margin above the wall top up to which a tube still counts as in (or beside) the bin, metres.
+constexpr double kCountMargin = 0.05;
+
+physics::RandomTubeParams DefaultShape(const SimCellParams& p) {
+  physics::RandomTubeParams shape =
+      p.material == Material::kRubber ? physics::RandomTubeParams::SetB() : physics::RandomTubeParams::SetA();
+  shape.radius = p.cell.tube.radius;
+  if (p.cell.tube.length > 0.0) shape.branches.front().length = p.cell.tube.length;
+  return shape;
+}
+
+/// Algorithm 2 tubes dropped into the bin (GenerateScene) with the material's friction.
+std::vector<physics::TubeGeometry> GenerateTubes(const SimCellParams& p) {
+  const SimMaterialParams material = p.material_params.value_or(SimMaterialParams::Defaults(p.material));
+  physics::SceneParams scene;
+  scene.tube_count = static_cast<int>(p.tubes);
+  scene.tubes = p.tube_shape.value_or(DefaultShape(p));
+  scene.bin = p.cell.bin;
+  scene.drop.tube_mass = p.cell.tube.mass;
+  scene.drop.tube_friction = std::sqrt(material.tube_friction);
+  scene.drop.bin_friction = material.bin_friction / std::sqrt(material.tube_friction);
+  const physics::DropResult drop = physics::GenerateScene(scene, physics::DeriveSeed(p.seed, 1));
+  spdlog::debug("sim cell: dropped {} tubes in {:.2f} s simulated ({})", drop.tubes.size(),
+                drop.simulated_time, drop.settled ? "settled" : "not settled");
+  return drop.tubes;
+}
+
+const SimCellParams& Validated(const SimCellParams& params) {
+  params.Validate();
+  return params;
+}
+
+}  // namespace
+
+double Seconds(Timeout timeout) { return std::chrono::duration<double>(timeout).count(); }
+
+SimCellState::SimCellState(const SimCellParams& p, const std::vector<physics::TubeGeometry>& tubes_Bin)
+    : params(p), noise_rng(physics::DeriveSeed(p.seed, 3)) {
+  world = std::make_unique<SimWorld>(params, tubes_Bin);
+  settled = world->Settle(params.physics.settle_time);
+  if (!settled)
+    spdlog::warn("sim cell: tubes still moving after {:.1f} s of settling", params.physics.settle_time);
+  start_time = world->time();
+
+  const BinConfig& bin = params.cell.bin;
+  const Eigen::Vector3d place = params.cell.place.X_BinPlace.translation();
+  const double margin = params.robot.reach_margin;
+  workspace.min() << std::min(-0.5 * bin.inner_size.x(), place.x()) - margin,
+      std::min(-0.5 * bin.inner_size.y(), place.y()) - margin, params.robot.min_height;
+  workspace.max() << std::max(0.5 * bin.inner_size.x(), place.x()) + margin,
+      std::max(0.5 * bin.inner_size.y(), place.y()) + margin, params.robot.max_height;
+}
+
+void SimCellState::ThrowIfInjected(SimDevice device, const std::string& who) const {
+  switch (faults[static_cast<int>(device)]) {
+    case SimFault::kNone:
+      return;
+    case SimFault::kTimeout:
+      throw DeviceTimeout(who + ": no answer (injected timeout)");
+    case SimFault::kFault:
+      throw DeviceFault(who + ": fault (injected)");
+  }
+}
+
+void SimCellState::Advance(double seconds) {
+  const int steps = static_cast<int>(std::ceil(seconds / params.physics.time_step - 1e-9));
+  for (int i = 0; i < steps; ++i) world->ControlStep();
+}
+
+Wrench SimCellState::RawFtReading() {
+  world->BeginWindow();
+  Advance(params.physics.ft_window);
+  Wrench w = world->WindowMean();
+  std::normal_distribution<double> force_noise(0.0, params.force_noise);
+  std::normal_distribution<double> torque_noise(0.0, params.torque_noise);
+  for (int i = 0; i < 3; ++i) {
+    w.force[i] += params.force_offset[i] + (params.force_noise > 0.0 ? force_noise(noise_rng) : 0.0);
+  }
+  for (int i = 0; i < 3; ++i) {
+    w.torque[i] += params.torque_offset[i] + (params.torque_noise > 0.0 ? torque_noise(noise_rng) : 0.0);
+  }
+  return w;
+}
+
+struct SimCell::Impl {
+  Impl(const SimCellParams& params, const std::vector<physics::TubeGeometry>& tubes_Bin)
+      : state(params, tubes_Bin), scanner(state), robot(state), gripper(state), ft(state) {}
+
+  SimCellState state;
+  SimScanner scanner;
+  SimRobot robot;
+  SimGripper gripper;
+  SimForceTorqueSensor ft;
+};
+
+SimCell::SimCell(const SimCellParams& params)
+    : impl_(std::make_unique<Impl>(params, GenerateTubes(Validated(params)))) {}
+
+SimCell::SimCell(const SimCellParams& params, const std::vector<physics::TubeGeometry>& tubes_Bin)
+    : impl_(std::make_unique<Impl>(Validated(params), tubes_Bin)) {}
+
+SimCell::~SimCell() = default;
+
+Scanner& SimCell::scanner() { return impl_->scanner; }
+Robot& SimCell::robot() { return impl_->robot; }
+Gripper& SimCell::gripper() { return impl_->gripper; }
+ForceTorqueSensor& SimCell::ft_sensor() { return impl_->ft; }
+
+const CellConfig& SimCell::cell() const { return impl_->state.params.cell; }
+const SimCellParams& SimCell::params() const { return impl_->state.params; }
+
+std::uint32_t SimCell::TubesInBin() const {
+  const SimWorld& world = *impl_->state.world;
+  const Eigen::Vector3d& size = cell().bin.inner_size;
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < world.tube_count(); ++i) {
+    const Eigen::Vector3d p = world.TubeCentreOfMass(i);
+    if (std::abs(p.x()) <= 0.5 * size.x() && std::abs(p.y()) <= 0.5 * size.y() && p.z() >= -kCountMargin &&
+        p.z() <= size.z() + kCountMargin) {
+      ++count;
+    }
+  }
+  return count;
+}
+
+std::uint32_t SimCell::TubesOutsideBin() const {
+  const SimWorld& world = *impl_->state.world;
+  const Eigen::Vector3d& size = cell().bin.inner_size;
+  const std::vector<std::size_t> held = world.HeldTubes();
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < world.tube_count(); ++i) {
+    if (std::binary_search(held.begin(), held.end(), i)) continue;
+    const Eigen::Vector3d p = world.TubeCentreOfMass(i);
+    const bool beside = std::abs(p.x()) > 0.5 * size.x() || std::abs(p.y()) > 0.5 * size.y();
+    if (beside && p.z() <= size.z() + kCountMargin) ++count;
+  }
+  return count;
+}
+
+double SimCell::SimulatedSeconds() const { return impl_->state.world->time() - impl_->state.start_time; }
+
+std::vector<physics::TubeGeometry> SimCell::TubesBin() const { return impl_->state.world->TubesBin(); }
+
+std::vector<Eigen::Vector3d> SimCell::TubeCentresOfMass() const {
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < impl_->state.world->tube_count(); ++i) {
+    out.push_back(impl_->state.world->TubeCentreOfMass(i));
+  }
+  return out;
+}
+
+std::vector<std::size_t> SimCell::HeldTubes() const { return impl_->state.world->HeldTubes(); }
+
+Eigen::Isometry3d SimCell::X_BinTcp() const { return impl_->state.world->X_BinTcp(); }
+
+Wrench SimCell::TrueWrench() const { return impl_->state.world->last_wrench(); }
+
+void SimCell::Advance(double seconds) { impl_->state.Advance(seconds); }
+
+void SimCell::InjectFault(SimDevice device, SimFault fault) {
+  impl_->state.faults[static_cast<int>(device)] = fault;
+}
+
+bool SimCell::settled() const { return impl_->state.settled; }
+
+}  // namespace tubepick::devices::sim

@@ -1,0 +1,236 @@
+#include "devices/sim/sim_tubes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/common/errors.h"
+
+namespace tubepick::devices::sim {
+namespace {
+
+using physics::FromBt;
+using physics::ToBt;
+
+/// A body's collision shape (owned by the world), its principal inertia for its mass, and where
+/// its frame C (centre of mass, principal axes) is.
+struct BodyShape {
+  btCollisionShape* shape = nullptr;
+  btVector3 inertia{0, 0, 0};
+  Eigen::Isometry3d X_BinC = Eigen::Isometry3d::Identity();
+  double radius = 0.0;
+};
+
+/// The compound of physics::MakeTubeShape (capsules, flat free ends).
+BodyShape CompoundShape(physics::BulletWorld& world, const std::vector<physics::TubeSegment>& segments,
+                        double mass, double margin) {
+  world.tube_shapes.push_back(physics::MakeTubeShape(segments, mass, margin));
+  const physics::TubeShape& s = world.tube_shapes.back();
+  return {s.compound.get(), s.inertia, s.X_TubeC, s.radius};
+}
+
+btRigidBody* AddBody(physics::BulletWorld& world, const BodyShape& s, double mass,
+                     const TubeBodyOptions& options, std::size_t tube_index, int link_index) {
+  btRigidBody::btRigidBodyConstructionInfo info(mass, nullptr, s.shape, s.inertia);
+  info.m_startWorldTransform = ToBt(s.X_BinC);
+  info.m_friction = options.body_friction;
+  info.m_rollingFriction = options.material.rolling_friction;
+  info.m_restitution = options.body_restitution;
+  info.m_linearDamping = options.linear_damping;
+  info.m_angularDamping = options.angular_damping;
+  info.m_linearSleepingThreshold = options.sleep_linear_velocity;
+  info.m_angularSleepingThreshold = options.sleep_angular_velocity;
+  btRigidBody* body = world.AddBody(info);
+  // Continuous collision: a swept sphere inside the tube whenever a step moves it more than R.
+  body->setCcdMotionThreshold(s.radius);
+  body->setCcdSweptSphereRadius(0.8 * s.radius);
+  body->setUserIndex(static_cast<int>(tube_index));
+  body->setUserIndex2(link_index);
+  return body;
+}
+
+std::vector<Eigen::Vector3d> ToBodyFrame(const BodyShape& shape,
+                                         const std::vector<Eigen::Vector3d>& points_Bin) {
+  const Eigen::Isometry3d X_CBin = shape.X_BinC.inverse();
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector3d& p : points_Bin) out.push_back(X_CBin * p);
+  return out;
+}
+
+/// Moment of inertia of `body` about the world axis `axis_Bin` through its centre of mass.
+double InertiaAbout(const btRigidBody& body, const Eigen::Vector3d& axis_Bin) {
+  const btVector3 a = ToBt(axis_Bin);
+  return 1.0 / a.dot(body.getInvInertiaTensorWorld() * a);
+}
+
+/// Rubber: a joint at p_Bin_joint between links a and b; its frame's z runs along link b.
+/// Translation and twist are locked; bending about x and y is an implicit angular spring.
+///
+/// Bullet solves a locked row with error-reduction e and constraint-force mixing c as the implicit
+/// spring-damper of ODE: for stiffness k and damping d at step h, e = h·k/(h·k + d) and, since
+/// Bullet's mixing is relative to the row's effective inertia J (its jacDiagABInv),
+/// c = J/(h·(h·k + d)). At rest the row holds a bend θ with the torque k·θ exactly. Unlike an
+/// explicit spring (btGeneric6DofSpring2Constraint's enableSpring), it is stable at any stiffness
+/// and settles with friction (explicit springs on links this light made bent hoses creep).
+std::unique_ptr<btGeneric6DofSpring2Constraint> MakeJoint(btRigidBody& a, btRigidBody& b,
+                                                          const Eigen::Vector3d& p_Bin_joint,
+                                                          const Eigen::Vector3d& direction_Bin, double link_a,
+                                                          double link_b, double mass_a, double mass_b,
+                                                          const SimMaterialParams& m, double h) {
+  Eigen::Isometry3d X_BinJ = Eigen::Isometry3d::Identity();
+  X_BinJ.linear() = physics::RotationFromZ(direction_Bin).toRotationMatrix();
+  X_BinJ.translation() = p_Bin_joint;
+  const btTransform frame_a = a.getCenterOfMassTransform().inverse() * ToBt(X_BinJ);
+  const btTransform frame_b = b.getCenterOfMassTransform().inverse() * ToBt(X_BinJ);
+  auto joint = std::make_unique<btGeneric6DofSpring2Constraint>(a, b, frame_a, frame_b, RO_XYZ);
+  joint->setLinearLowerLimit(btVector3(0, 0, 0));
+  joint->setLinearUpperLimit(btVector3(0, 0, 0));
+  joint->setAngularLowerLimit(btVector3(0, 0, 0));
+  joint->setAngularUpperLimit(btVector3(0, 0, 0));
+  // A discretised beam: a joint stands for the mean length of its two links.
+  const double stiffness = m.bending_stiffness / (0.5 * (link_a + link_b));
+  for (int axis = 3; axis <= 4; ++axis) {
+    const Eigen::Vector3d axis_Bin = X_BinJ.linear().col(axis - 3);
+    // The row's effective inertia as Bullet computes it (both links turning about their centres,
+    // with Bullet's own capsule inertia), and the damping that makes the lighter link, turning
+    // about the joint, damped by damping_ratio.
+    const double inertia_a = InertiaAbout(a, axis_Bin), inertia_b = InertiaAbout(b, axis_Bin);
+    const double row_inertia = 1.0 / (1.0 / inertia_a + 1.0 / inertia_b);
+    const double about_joint =
+        std::min(inertia_a + mass_a * 0.25 * link_a * link_a, inertia_b + mass_b * 0.25 * link_b * link_b);
+    const double damping = 2.0 * m.damping_ratio * std::sqrt(stiffness * about_joint);
+    joint->setParam(BT_CONSTRAINT_STOP_ERP, h * stiffness / (h * stiffness + damping), axis);
+    joint->setParam(BT_CONSTRAINT_STOP_CFM, row_inertia / (h * (h * stiffness + damping)), axis);
+  }
+  return joint;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> ResamplePolyline(const std::vector<Eigen::Vector3d>& line, int count) {
+  std::vector<double> cumulative{0.0};
+  for (std::size_t i = 1; i < line.size(); ++i)
+    cumulative.push_back(cumulative.back() + (line[i] - line[i - 1]).norm());
+  const double length = cumulative.back();
+  std::vector<Eigen::Vector3d> out;
+  std::size_t k = 1;
+  for (int j = 0; j < count; ++j) {
+    if (j == count - 1) {
+      out.push_back(line.back());
+      break;
+    }
+    const double s = length * j / (count - 1);
+    while (k + 1 < line.size() && cumulative[k] < s) ++k;
+    const double span = cumulative[k] - cumulative[k - 1];
+    const double t = span > 0.0 ? (s - cumulative[k - 1]) / span : 0.0;
+    out.push_back(line[k - 1] + std::clamp(t, 0.0, 1.0) * (line[k] - line[k - 1]));
+  }
+  return out;
+}
+
+SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin, std::size_t tube_index,
+                   const TubeBodyOptions& options) {
+  const std::vector<Eigen::Vector3d> line = tube_Bin.Centreline();  // throws when not linear
+  const double length = tube_Bin.Length();
+  if (!(length > 0.0))
+    throw InvalidArgument("sim cell: tube " + std::to_string(tube_Bin.id) + " has no length");
+  SimTube tube;
+  tube.id = tube_Bin.id;
+  tube.radius = tube_Bin.edges.front().radius;
+  tube.mass = options.mass;
+
+  if (!options.rubber) {
+    const BodyShape shape = CompoundShape(world, physics::MakeTubeSegments(tube_Bin.ToTube(), 0.001),
+                                          options.mass, options.collision_margin);
+    SimLink link;
+    link.p_C_points = ToBodyFrame(shape, line);
+    link.mass = options.mass;
+    link.body = AddBody(world, shape, options.mass, options, tube_index, 0);
+    tube.links.push_back(std::move(link));
+    return tube;
+  }
+
+  const int links = std::max(2, static_cast<int>(std::lround(length / options.material.link_length)));
+  const std::vector<Eigen::Vector3d> points = ResamplePolyline(line, links + 1);
+  std::vector<double> lengths;
+  double chord_sum = 0.0;
+  for (int j = 0; j < links; ++j) {
+    lengths.push_back((points[j + 1] - points[j]).norm());
+    chord_sum += lengths.back();
+  }
+  for (int j = 0; j < links; ++j) {
+    physics::TubeSegment seg;
+    seg.a = points[j];
+    seg.b = points[j + 1];
+    seg.radius = tube.radius;
+    seg.sphere_a = j > 0;  // the tube's free ends are flat
+    seg.sphere_b = j + 1 < links;
+    const double mass = options.mass * lengths[j] / chord_sum;
+    // A one-child compound even for the inner links: bare capsules collide analytically but with a
+    // single contact point per pair, which let piles of hoses rock instead of coming to rest (a
+    // pick cycle cost 40 % more).
+    const BodyShape shape = CompoundShape(world, {seg}, mass, options.collision_margin);
+    SimLink link;
+    link.p_C_points = ToBodyFrame(shape, {seg.a, seg.b});
+    link.mass = mass;
+    link.body = AddBody(world, shape, mass, options, tube_index, j);
+    tube.links.push_back(std::move(link));
+  }
+  for (int j = 1; j < links; ++j) {
+    tube.joints.push_back(MakeJoint(
+        *tube.links[j - 1].body, *tube.links[j].body, points[j], points[j + 1] - points[j], lengths[j - 1],
+        lengths[j], tube.links[j - 1].mass, tube.links[j].mass, options.material, options.time_step));
+    world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+  }
+  // Links two apart may overlap at a sharp bend of the rest shape; farther ones cannot (Algorithm
+  // 2 rejects self-intersecting tubes).
+  for (int j = 2; j < links; ++j) {
+    tube.links[j - 2].body->setIgnoreCollisionCheck(tube.links[j].body, true);
+    tube.links[j].body->setIgnoreCollisionCheck(tube.links[j - 2].body, true);
+  }
+  return tube;
+}
+
+physics::TubeGeometry CurrentGeometry(const SimTube& tube) {
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t l = 0; l < tube.links.size(); ++l) {
+    const SimLink& link = tube.links[l];
+    const Eigen::Isometry3d X_BinC = FromBt(link.body->getWorldTransform());
+    for (std::size_t k = 0; k < link.p_C_points.size(); ++k) {
+      const Eigen::Vector3d p = X_BinC * link.p_C_points[k];
+      if (l > 0 && k == 0) {
+        points.back() = 0.5 * (points.back() + p);  // the joint both links share
+      } else {
+        points.push_back(p);
+      }
+    }
+  }
+  physics::TubeGeometry g;
+  g.id = tube.id;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    g.nodes.push_back({static_cast<int>(i + 1), points[i], tube.radius});
+  }
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    physics::TubeEdge e;
+    e.node1 = static_cast<int>(i + 1);
+    e.node2 = static_cast<int>(i + 2);
+    e.name = "e_" + std::to_string(e.node1) + "_" + std::to_string(e.node2);
+    e.order = static_cast<int>(i + 1);
+    e.radius = tube.radius;
+    physics::SetEdgeFromNodes(g, e);
+    g.edges.push_back(e);
+  }
+  return g;
+}
+
+Eigen::Vector3d CentreOfMass(const SimTube& tube) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double mass = 0.0;
+  for (const SimLink& link : tube.links) {
+    sum += link.mass * FromBt(link.body->getWorldTransform().getOrigin());
+    mass += link.mass;
+  }
+  return sum / mass;
+}
+
+}  // namespace tubepick::devices::sim

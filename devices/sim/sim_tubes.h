@@ -1,0 +1,77 @@
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <btBulletDynamicsCommon.h>
+#include <Eigen/Core>
+
+#include "devices/sim/sim_cell.h"
+#include "physics/tube_bodies.h"
+#include "physics/tube_geometry.h"
+
+namespace tubepick::devices::sim {
+
+/// btCollisionObject user index of bodies that are not tube links.
+inline constexpr int kStaticUserIndex = -1;
+inline constexpr int kGripperUserIndex = -2;
+
+/// One rigid body of a simulated tube (the whole tube for pvc, one chain link for rubber).
+struct SimLink {
+  btRigidBody* body = nullptr;
+  /// Centreline points of this body, in order along the tube, in its body frame C (centre of mass,
+  /// principal axes).
+  std::vector<Eigen::Vector3d> p_C_points;
+  double mass = 0.0;
+};
+
+/// A tube of the cell: its bodies and, for rubber, the spring joints between consecutive links.
+struct SimTube {
+  int id = 0;
+  double radius = 0.0;
+  double mass = 0.0;
+  std::vector<SimLink> links;
+  std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> joints;
+};
+
+/// How tube bodies are made.
+struct TubeBodyOptions {
+  bool rubber = false;
+  /// Mass of one tube, kg.
+  double mass = 0.055;
+  SimMaterialParams material;
+  /// Bullet body friction and restitution (the per-body factors of the pair products).
+  double body_friction = 0.5;
+  double body_restitution = 0.3;
+  double collision_margin = 0.001;
+  double sleep_linear_velocity = 0.02;
+  double sleep_angular_velocity = 0.2;
+  double linear_damping = 0.05;
+  double angular_damping = 0.2;
+  /// Bullet step, seconds (the rubber joints' implicit springs are tuned for it).
+  double time_step = 1.0 / 480.0;
+};
+
+/// Adds `tube_Bin` (linear; bin frame) to `world` where it is: one rigid capsule compound (pvc,
+/// physics::MakeTubeShape) or a chain of capsule links joined at the centreline by
+/// btGeneric6DofSpring2Constraints (rubber: locked translation and twist, implicit angular springs
+/// about both bending axes whose rest angle is the generated shape).
+/// Links within two of each other do not collide. Every body's user index is `tube_index` and user
+/// index 2 its link index.
+/// @throws InvalidArgument when the tube is not linear or has no length.
+SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin, std::size_t tube_index,
+                   const TubeBodyOptions& options);
+
+/// The tube as it is now, bin frame: its centreline points as nodes (ids 1..n, in order; a joint
+/// shared by two links is the mean of both), an edge between consecutive nodes ("e_<i>_<i+1>",
+/// order i, the tube's radius).
+physics::TubeGeometry CurrentGeometry(const SimTube& tube);
+
+/// Mass-weighted centre of the tube's bodies, bin frame.
+Eigen::Vector3d CentreOfMass(const SimTube& tube);
+
+/// Points at equal arc-length spacing along the polyline, both ends included (count ≥ 2).
+std::vector<Eigen::Vector3d> ResamplePolyline(const std::vector<Eigen::Vector3d>& line, int count);
+
+}  // namespace tubepick::devices::sim

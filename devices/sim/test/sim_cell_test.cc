@@ -1,0 +1,391 @@
+#include "devices/sim/sim_cell.h"
+
+#include <cmath>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/common/errors.h"
+#include "devices/sim/test/sim_test_util.h"
+
+namespace tubepick::devices::sim {
+namespace {
+
+using namespace testing;  // NOLINT: the sim test helpers
+using ::testing::HasSubstr;
+
+/// Force along the vertical within this of the expected weight, N (noise σ 0.02 N per read, two
+/// reads, plus the solver's residual).
+constexpr double kForceTol = 0.08;
+
+/// A straight tube along x on the floor, centred at x = 0, through five nodes.
+physics::TubeGeometry StraightTube(int id, double radius, double length, double y = 0.0) {
+  return PolylineTube(id,
+                      {{-0.5 * length, y, radius},
+                       {-0.25 * length, y, radius},
+                       {0.0, y, radius},
+                       {0.25 * length, y, radius},
+                       {0.5 * length, y, radius}},
+                      radius);
+}
+
+/// The sensor's upward force component: −weight held.
+double UpForce(const WrenchReading& reading, const Eigen::Isometry3d& X_BinTcp) {
+  return reading.force.dot(UpTcp(X_BinTcp));
+}
+
+TEST(SimCell, MaterialNamesRoundTrip) {
+  EXPECT_EQ(ParseMaterial("pvc", "material"), Material::kPvc);
+  EXPECT_EQ(ParseMaterial(ToString(Material::kRubber), "material"), Material::kRubber);
+  try {
+    ParseMaterial("steel", "cell.material");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cell.material"));
+    EXPECT_THAT(e.what(), HasSubstr("steel"));
+  }
+  EXPECT_DOUBLE_EQ(ThesisTubes(Material::kRubber).mass, 0.110);
+  EXPECT_DOUBLE_EQ(ThesisTubes(Material::kPvc).radius, 0.0125);
+}
+
+TEST(SimCell, InvalidParamsNameTheField) {
+  SimCellParams params;
+  params.physics.time_step = 0.0;
+  try {
+    SimCell cell(params);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("physics.time_step"));
+  }
+}
+
+TEST(SimCell, ConstructionDropsEveryTubeIntoTheBin) {
+  for (Material material : {Material::kPvc, Material::kRubber}) {
+    SCOPED_TRACE(ToString(material));
+    const SimCell cell(SimCellParams::Thesis(material, 7, 11));
+    EXPECT_TRUE(cell.settled());
+    EXPECT_EQ(cell.TubesInBin(), 7u);
+    EXPECT_EQ(cell.TubesOutsideBin(), 0u);
+    EXPECT_EQ(cell.TubesBin().size(), 7u);
+    EXPECT_DOUBLE_EQ(cell.SimulatedSeconds(), 0.0);
+    for (const Eigen::Vector3d& p : cell.TubeCentresOfMass()) {
+      EXPECT_LT(p.z(), 0.12);  // lying in the bin, not balanced on a wall
+    }
+  }
+}
+
+TEST(SimCell, IsolatedTubeLiftReadsItsWeightAndPlacesOutside) {
+  SimCellParams params;
+  params.seed = 4;
+  const double r = params.cell.tube.radius, m = params.cell.tube.mass;
+  SimCell cell(params, {StraightTube(1, r, 0.5)});
+  ASSERT_TRUE(cell.settled());
+  ASSERT_EQ(cell.TubesInBin(), 1u);
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  cell.ft_sensor().Bias(kLong);
+  const WrenchReading empty = cell.ft_sensor().Read(kLong);
+  EXPECT_NEAR(empty.force.norm(), 0.0, 0.08);  // biased: offsets gone, noise left
+
+  // Grasp 15 cm from the −x end: the centre of mass is 10 cm along +x from the TCP.
+  const Eigen::Isometry3d X_grasp = GraspAt(cell.TubesBin()[0], 0.15);
+  const GripperStatus status = Grasp(cell, X_grasp);
+  EXPECT_EQ(status.object, GripperObject::kStoppedClosing);
+  EXPECT_NEAR(status.opening, 2 * r, 0.002);
+  EXPECT_EQ(cell.HeldTubes(), std::vector<std::size_t>{0});
+  // Closed on a tube that still lies on the floor: the floor carries it.
+  const WrenchReading before = cell.ft_sensor().Read(kLong);
+  EXPECT_NEAR(UpForce(before, cell.X_BinTcp()), 0.0, kForceTol);
+
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)}, 0.25, kLong);
+  EXPECT_NEAR(cell.X_BinTcp().translation().z(), X_grasp.translation().z() + 0.3, 1e-9);
+  const WrenchReading after = cell.ft_sensor().Read(kLong);
+  // Sign convention (core/wrench/wrench.h): the force the payload exerts on the sensor, so its
+  // upward component is −m·g; with z_Tcp down, F_z = +m·g in the sensor axes.
+  const double up = UpForce(after, cell.X_BinTcp()) - UpForce(before, cell.X_BinTcp());
+  EXPECT_NEAR(up, -m * kG, kForceTol);
+  EXPECT_NEAR(after.force.z(), m * kG, kForceTol);
+  // Torque about the TCP: r × F with r = 0.1 m along the tube (x_Bin), F = −m·g z_Bin.
+  const Eigen::Vector3d torque_Bin = cell.X_BinTcp().linear() * after.torque;
+  EXPECT_NEAR(torque_Bin.y(), 0.1 * m * kG, 0.01);
+  EXPECT_NEAR(torque_Bin.x(), 0.0, 0.01);
+  EXPECT_EQ(cell.TubesInBin(), 0u);       // carried out of the bin volume
+  EXPECT_EQ(cell.TubesOutsideBin(), 0u);  // but still held
+
+  // Place: over the wall, down to the place frame, open.
+  Eigen::Isometry3d X_place = cell.X_BinTcp();
+  X_place.translation() = cell.cell().place.X_BinPlace.translation() + Eigen::Vector3d(0, 0, 0.05);
+  cell.robot().MoveTo(Raised(X_place, 0.3), 0.25, kLong);
+  cell.robot().MoveTo(X_place, 0.25, kLong);
+  const GripperStatus opened = cell.gripper().Open(kLong);
+  EXPECT_EQ(opened.object, GripperObject::kAtPosition);
+  EXPECT_TRUE(cell.HeldTubes().empty());
+  cell.Advance(1.0);
+  EXPECT_EQ(cell.TubesOutsideBin(), 1u);
+  EXPECT_EQ(cell.TubesInBin(), 0u);
+  EXPECT_LT(cell.TubeCentresOfMass()[0].z(), 0.03);  // on the ground
+}
+
+TEST(SimCell, CloseOnNothingReachesFullyClosed) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  Eigen::Isometry3d X = SimRobotParams::DefaultStart();
+  X.translation() = Eigen::Vector3d(0.0, 0.2, 0.05);  // beside the tube
+  cell.robot().MoveTo(X, 0.25, kLong);
+  const GripperStatus status = cell.gripper().Close(0.1, 50.0, kLong);
+  EXPECT_EQ(status.object, GripperObject::kAtPosition);
+  EXPECT_NEAR(status.opening, 0.0, 1e-12);
+  EXPECT_TRUE(cell.HeldTubes().empty());
+}
+
+/// Tube A along x on the floor; tube B a bridge across A at x = 0.05: its flat middle rests on A,
+/// its legs reach down to the floor on both sides. Lifting A carries B hanging over it.
+std::vector<physics::TubeGeometry> BridgedTubes(double r) {
+  const double top = 3.0 * r + 0.001;
+  return {StraightTube(1, r, 0.4),
+          PolylineTube(2, {{0.05, -0.22, r}, {0.05, -0.03, top}, {0.05, 0.03, top}, {0.05, 0.22, r}}, r)};
+}
+
+TEST(SimCell, EntangledTubesReadTwoWeightsAndATorque) {
+  SimCellParams params;
+  const double r = params.cell.tube.radius, m = params.cell.tube.mass;
+  SimCell cell(params, BridgedTubes(r));
+  ASSERT_TRUE(cell.settled());
+  ASSERT_EQ(cell.TubesInBin(), 2u);
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  cell.ft_sensor().Bias(kLong);
+  const WrenchReading reference = cell.ft_sensor().Read(kLong);
+
+  // Grasp A at x = −0.1: A's centre of mass is 0.10 m along +x from the TCP, B's 0.15 m.
+  const Eigen::Isometry3d X_grasp = GraspAt(cell.TubesBin()[0], 0.1);
+  ASSERT_NEAR(X_grasp.translation().x(), -0.1, 1e-9);
+  ASSERT_EQ(Grasp(cell, X_grasp).object, GripperObject::kStoppedClosing);
+  EXPECT_EQ(cell.HeldTubes(), std::vector<std::size_t>{0});  // only A is held by the fingers
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)}, 0.25, kLong);
+  const WrenchReading lifted = cell.ft_sensor().Read(kLong);
+  EXPECT_EQ(cell.TubesInBin(), 0u);  // B came along
+
+  const double up = UpForce(lifted, cell.X_BinTcp()) - UpForce(reference, cell.X_BinTcp());
+  EXPECT_NEAR(up, -2.0 * m * kG, 2 * kForceTol);
+  // Horizontal torque about the TCP: Σ r × F = (0, g·m·(0.10 + 0.15), 0) in the bin frame.
+  const Eigen::Vector3d torque_Bin = cell.X_BinTcp().linear() * (lifted.torque - reference.torque);
+  EXPECT_NEAR(torque_Bin.y(), m * kG * 0.25, 0.02);
+  EXPECT_NEAR(torque_Bin.x(), 0.0, 0.02);
+  EXPECT_NEAR(torque_Bin.z(), 0.0, 0.01);
+}
+
+TEST(SimCell, RubberSagsWhenLiftedAtOneEndPvcDoesNot) {
+  double sag[2] = {0.0, 0.0};
+  for (Material material : {Material::kPvc, Material::kRubber}) {
+    SimCellParams params = SimCellParams::Thesis(Material::kRubber, 1, 1);  // same hose size for both
+    params.material = material;
+    const double r = params.cell.tube.radius, m = params.cell.tube.mass;
+    SimCell cell(params, {StraightTube(1, r, 0.4)});
+    cell.robot().ServoOn(kLong);
+    cell.gripper().Activate(kLong);
+    cell.ft_sensor().Bias(kLong);
+    ASSERT_EQ(Grasp(cell, GraspAt(cell.TubesBin()[0], 0.025)).object, GripperObject::kStoppedClosing);
+    cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)}, 0.25, kLong);
+    cell.Advance(0.5);
+    const std::vector<Eigen::Vector3d> line = cell.TubesBin()[0].Centreline();
+    const double far_end_z = line.front().x() > line.back().x() ? line.front().z() : line.back().z();
+    sag[material == Material::kRubber] = cell.X_BinTcp().translation().z() - far_end_z;
+    // Either way the sensor carries the whole tube.
+    EXPECT_NEAR(UpForce(cell.ft_sensor().Read(kLong), cell.X_BinTcp()), -m * kG, kForceTol);
+  }
+  EXPECT_LT(std::abs(sag[0]), 0.003);  // rigid PVC: only the grip's compliance
+  // Rubber: EI = 0.1 N·m², 110 g over 40 cm, 37.5 cm cantilever ⇒ beam theory 6.7 cm.
+  EXPECT_GT(sag[1], 0.04);
+  EXPECT_LT(sag[1], 0.10);
+}
+
+TEST(SimCell, ScanSeesTheTubes) {
+  SimCellParams params;
+  params.tubes = 3;
+  params.cell.sensor.unit = LengthUnit::kMillimetre;
+  SimCell cell(params);
+  const Capture capture = cell.scanner().Scan(kLong);
+  EXPECT_NEAR(cell.SimulatedSeconds(), params.physics.scan_duration, params.physics.time_step);
+  EXPECT_EQ(capture.unit, LengthUnit::kMillimetre);
+  EXPECT_TRUE(capture.X_BinSensor.isApprox(params.cell.sensor.X_BinSensor));
+  ASSERT_GT(capture.points_Sensor.size(), 100000u);
+  // Points on a tube's surface: at the tube's radius from its centreline.
+  const std::vector<physics::TubeGeometry> tubes = cell.TubesBin();
+  const double r = params.cell.tube.radius;
+  std::size_t on_tubes = 0;
+  for (std::size_t i = 0; i < capture.points_Sensor.size(); i += 10) {
+    const Eigen::Vector3d p = capture.X_BinSensor * (capture.points_Sensor[i].cast<double>() * 1e-3);
+    for (const physics::TubeGeometry& tube : tubes) {
+      bool hit = false;
+      for (const Cylinder& c : tube.Cylinders()) {
+        const double t = std::clamp((p - c.start).dot(c.axis()), 0.0, c.length());
+        if (std::abs((p - (c.start + t * c.axis())).norm() - r) < 0.002) hit = true;
+      }
+      if (hit) {
+        ++on_tubes;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(on_tubes, 2000u);  // of every 10th point: > 20 000 points on tubes
+  // A second scan has fresh noise: different points, same scene.
+  const Capture again = cell.scanner().Scan(kLong);
+  EXPECT_NE(again.points_Sensor.front(), capture.points_Sensor.front());
+}
+
+TEST(SimCell, RobotFaults) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  Eigen::Isometry3d X = SimRobotParams::DefaultStart();
+  X.translation() = Eigen::Vector3d(0.1, 0.1, 0.3);
+  EXPECT_THAT([&] { cell.robot().MoveTo(X, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("servo off")));
+  cell.robot().ServoOn(kLong);
+  cell.robot().MoveTo(X, 0.25, kLong);
+  EXPECT_TRUE(cell.robot().CurrentPose(kLong).isApprox(X, 1e-12));
+
+  Eigen::Isometry3d far = X;
+  far.translation() = Eigen::Vector3d(2.0, 0.0, 0.3);
+  EXPECT_THAT([&] { cell.robot().MoveTo(far, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("out of reach")));
+  EXPECT_THAT(
+      [&] {
+        cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 2.0)}, 0.25, kLong);
+      },
+      ::testing::ThrowsMessage<DeviceFault>(HasSubstr("out of reach")));
+  Eigen::Isometry3d tilted = X;
+  tilted.linear() = Eigen::AngleAxisd(70.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()) * X.linear();
+  EXPECT_THAT([&] { cell.robot().MoveTo(tilted, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("joint limit")));
+  EXPECT_TRUE(cell.robot().CurrentPose(kLong).isApprox(X, 1e-12));  // nothing moved
+  // 45° (the thesis' resolution rotation) is within the limit.
+  tilted.linear() = Eigen::AngleAxisd(M_PI / 4.0, Eigen::Vector3d::UnitY()) * X.linear();
+  cell.robot().MoveTo(tilted, 0.25, kLong);
+
+  // A move that needs longer than its timeout stops on the way.
+  cell.robot().MoveTo(X, 0.25, kLong);
+  Eigen::Isometry3d low = X;
+  low.translation().z() = 0.1;
+  EXPECT_THROW(cell.robot().MoveTo(low, 0.1, Timeout(200)), DeviceTimeout);
+  const double z = cell.robot().CurrentPose(kLong).translation().z();
+  EXPECT_LT(z, 0.3);
+  EXPECT_GT(z, 0.1);
+
+  // Driving the fingers into the floor: protective stop, servo off.
+  Eigen::Isometry3d floor = X;
+  floor.translation() = Eigen::Vector3d(0.1, 0.2, -0.015);
+  EXPECT_THAT([&] { cell.robot().MoveTo(floor, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("protective stop")));
+  EXPECT_GT(cell.robot().CurrentPose(kLong).translation().z(), -0.01);
+  EXPECT_THAT([&] { cell.robot().MoveTo(X, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("servo off")));
+  cell.robot().ServoOn(kLong);
+  cell.robot().MoveTo(X, 0.25, kLong);
+}
+
+TEST(SimCell, HousingInAWallStopsOnlyWhenAsked) {
+  for (bool housing_stop : {false, true}) {
+    SimCellParams params;
+    params.robot.housing_stop = housing_stop;
+    SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5, -0.15)});
+    cell.robot().ServoOn(kLong);
+    cell.gripper().Activate(kLong);
+    cell.gripper().Close(0.15, 50.0, kLong);  // pads together: ±10 mm around the TCP
+    // 3 cm from the +y wall: the pads clear it, the housing (±65 mm along y_Tcp) does not.
+    Eigen::Isometry3d X = SimRobotParams::DefaultStart();
+    X.translation() = Eigen::Vector3d(0.0, 0.27, 0.3);
+    cell.robot().MoveTo(X, 0.25, kLong);
+    X.translation().z() = 0.05;
+    if (housing_stop) {
+      EXPECT_THAT([&] { cell.robot().MoveTo(X, 0.25, kLong); },
+                  ::testing::ThrowsMessage<DeviceFault>(HasSubstr("housing hit a bin wall")));
+    } else {
+      cell.robot().MoveTo(X, 0.25, kLong);  // logs a warning
+      EXPECT_TRUE(cell.X_BinTcp().isApprox(X, 1e-12));
+    }
+  }
+}
+
+TEST(SimCell, GripperAndSensorFaults) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  EXPECT_THAT([&] { cell.gripper().Close(0.05, 50.0, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("not activated")));
+  EXPECT_FALSE(cell.gripper().Status(kLong).activated);
+  cell.gripper().Activate(kLong);
+  EXPECT_TRUE(cell.gripper().Status(kLong).activated);
+
+  cell.InjectFault(SimDevice::kGripper, SimFault::kFault);
+  EXPECT_THROW(cell.gripper().Open(kLong), DeviceFault);
+  EXPECT_EQ(cell.gripper().Status(kLong).fault, 0x0E);  // reported, not thrown
+  cell.InjectFault(SimDevice::kGripper, SimFault::kTimeout);
+  EXPECT_THROW(cell.gripper().Status(kLong), DeviceTimeout);
+  cell.InjectFault(SimDevice::kGripper, SimFault::kNone);
+  EXPECT_EQ(cell.gripper().Status(kLong).fault, 0);
+
+  cell.InjectFault(SimDevice::kForceTorque, SimFault::kTimeout);
+  EXPECT_THROW(cell.ft_sensor().Read(kLong), DeviceTimeout);
+  cell.InjectFault(SimDevice::kForceTorque, SimFault::kNone);
+  // Unbiased, the sensor reads its offsets.
+  EXPECT_NEAR((cell.ft_sensor().Read(kLong).force - params.force_offset).norm(), 0.0, 0.1);
+
+  cell.InjectFault(SimDevice::kScanner, SimFault::kFault);
+  EXPECT_THROW(cell.scanner().Scan(kLong), DeviceFault);
+  cell.InjectFault(SimDevice::kScanner, SimFault::kNone);
+  EXPECT_THROW(cell.scanner().Scan(Timeout(100)), DeviceTimeout);  // a scan takes 0.5 s
+  cell.InjectFault(SimDevice::kRobot, SimFault::kTimeout);
+  EXPECT_THROW(cell.robot().ServoOn(kLong), DeviceTimeout);
+}
+
+/// A short pick on a generated bin, returning what a controller would log.
+struct PickLog {
+  std::vector<WrenchReading> readings;
+  std::vector<Eigen::Vector3d> centres;
+  double seconds = 0.0;
+};
+
+PickLog PickTopTube(const SimCellParams& params) {
+  SimCell cell(params);
+  PickLog log;
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  cell.ft_sensor().Bias(kLong);
+  const Capture capture = cell.scanner().Scan(kLong);
+  log.centres.push_back(capture.X_BinSensor *
+                        capture.points_Sensor[capture.points_Sensor.size() / 2].cast<double>());
+  const std::vector<physics::TubeGeometry> tubes = cell.TubesBin();
+  const std::vector<Eigen::Vector3d> coms = cell.TubeCentresOfMass();
+  std::size_t top = 0;
+  for (std::size_t i = 1; i < coms.size(); ++i) {
+    if (coms[i].z() > coms[top].z()) top = i;
+  }
+  Grasp(cell, MiddleGrasp(tubes[top]));
+  log.readings.push_back(cell.ft_sensor().Read(kLong));
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)}, 0.25, kLong);
+  log.readings.push_back(cell.ft_sensor().Read(kLong));
+  for (const Eigen::Vector3d& p : cell.TubeCentresOfMass()) log.centres.push_back(p);
+  log.seconds = cell.SimulatedSeconds();
+  return log;
+}
+
+TEST(SimCell, SameParamsSameCell) {
+  SimCellParams params = SimCellParams::Thesis(Material::kRubber, 4, 21);
+  const PickLog a = PickTopTube(params);
+  const PickLog b = PickTopTube(params);
+  ASSERT_EQ(a.readings.size(), b.readings.size());
+  for (std::size_t i = 0; i < a.readings.size(); ++i) {
+    EXPECT_EQ(a.readings[i].force, b.readings[i].force);
+    EXPECT_EQ(a.readings[i].torque, b.readings[i].torque);
+  }
+  EXPECT_EQ(a.centres, b.centres);
+  EXPECT_EQ(a.seconds, b.seconds);
+  params.seed = 22;
+  EXPECT_NE(PickTopTube(params).centres, a.centres);
+}
+
+}  // namespace
+}  // namespace tubepick::devices::sim
