@@ -1,0 +1,168 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "clients/cell/cell_controller_params.h"
+#include "clients/cell/cell_fault.h"
+#include "clients/cell/cell_records.h"
+#include "clients/cell/planner_client.h"
+#include "core/common/cell_config.h"
+#include "devices/force_torque_sensor.h"
+#include "devices/gripper.h"
+#include "devices/robot.h"
+#include "devices/scanner.h"
+
+namespace tubepick::cell {
+
+/// The states of the pick-and-place cycle (thesis Figure 5.1 with the skills of Table 5.1).
+enum class CellState {
+  kStart,        ///< servo on, activate and open the gripper, go home
+  kBias,         ///< zero the F/T sensor at home (empty gripper)
+  kScan,         ///< PhotoneoSkill: capture the bin from home
+  kPlan,         ///< TubePickPlannerSkill: PlanPick
+  kApproach,     ///< MoveArmSkill: transit to the pre-grasp pose, open to the grasp width
+  kReference,    ///< F/T reference with the gripper empty, in the grasp orientation
+  kGrasp,        ///< down to the grasp pose, RobotiqGripperSkill: close
+  kLift,         ///< MoveArmSkill along the plan's waypoints
+  kAnalyze,      ///< ForceTorqueAnalysisSkill: AnalyzeWrench
+  kPlace,        ///< transit to the place pose, open
+  kResolve,      ///< resolution rotations, each followed by a new reading and analysis
+  kReturnToBin,  ///< lower the tubes back into the bin and open
+  kRelease,      ///< open after nothing was grasped / lifted
+  kHome,         ///< back to the home pose
+  kSafeStop,     ///< open the gripper and move up, if possible
+};
+
+/// "start", "bias", "scan", ...
+std::string ToString(CellState state);
+
+/// The four devices of the cell; not owned, must outlive the controller.
+struct CellDevices {
+  devices::Scanner* scanner = nullptr;
+  devices::Robot* robot = nullptr;
+  devices::Gripper* gripper = nullptr;
+  devices::ForceTorqueSensor* ft_sensor = nullptr;
+};
+
+/// How a run ended.
+enum class CellStopReason {
+  kBinEmpty,      ///< the planner reported an empty bin
+  kLimitReached,  ///< an attempt limit (per tube, per bin, consecutive failures)
+  kFault,         ///< a device or planner fault; a safe stop was performed
+};
+/// "bin_empty", "limit_reached", "fault".
+std::string ToString(CellStopReason reason);
+
+struct CellRunResult {
+  CellStopReason reason = CellStopReason::kBinEmpty;
+  /// One line for the operator: what happened and, for a fault, the device, state and error.
+  std::string message;
+  std::uint32_t picks = 0;
+  /// Picking attempts (grasp executions).
+  std::uint32_t attempts = 0;
+  std::uint32_t scans = 0;
+  /// Set when reason == kFault.
+  std::optional<CellFault> fault;
+  /// Safe stop: whether the gripper could be opened and the robot moved up.
+  bool gripper_opened = false;
+  bool moved_up = false;
+};
+
+/// The cell controller: runs the pick-and-place cycle of the thesis (§5.1-5.2) until the bin is
+/// empty, a limit is reached or a fault stops it.
+///
+///   start → bias F/T → [scan → PlanPick → bin empty? end
+///     → approach (pre-grasp, open to the grasp width) → F/T reference → grasp → object detected?
+///         no: open, count a failed grasp, next plan of the same scan or rescan
+///     → lift along the waypoints → read F/T → AnalyzeWrench
+///         SINGLE: place, open, count the pick
+///         NONE: open, rescan
+///         MULTIPLE: resolution motions in order (back to the lift pose, re-read, re-analyse after
+///           each) → single: place; still several: lower into the bin, open, rescan] → ...
+///
+/// The F/T reference is taken per attempt at the pre-grasp pose (gripper empty, already in the
+/// grasp orientation), which is the thesis' "reference with no object held" without the drift and
+/// orientation change between the start of a round and a later pick.
+///
+/// Plans the tool cannot execute without touching the bin (ToolClearanceProblem) are skipped and
+/// listed in the next record's skipped_plans; a scan without an executable plan is a "no_plan"
+/// record and a rescan.
+///
+/// Every picking attempt (and every scan without a plan) is one record ("type": "attempt"):
+///   round, attempt, scan, plan_rank, seed, tubes_left_plan (tubes the planner modeled),
+///   plans (count), bin_empty, used_simulation, tube, trajectory_kind, cost, grasp {tcp_pose,
+///   opening_width}, gripper (status after closing), wrench {reference, lift, after_resolution[]},
+///   analysis {outcome, tube_ratio, held_weight, estimated_count, motions}, resolution {available,
+///   used, succeeded}, result ("picked", "multiple_returned", "none", "grasp_failed", "no_plan",
+///   "fault"), fault {device, kind, state, error}, durations {planning_wall_s, planning_server_s,
+///   analysis_wall_s, robot_wall_s, robot_device_s, attempt_wall_s, attempt_device_s},
+///   truth_before / truth_after (the annotator's object, when set).
+/// A safe stop writes {"type": "safe_stop", ...}; every run ends with {"type": "end", reason,
+/// message, picks, attempts, scans, truth}.
+class CellController {
+ public:
+  /// @throws InvalidArgument when a device pointer is null or params/cell are invalid.
+  CellController(CellDevices devices, PlannerClient& planner, CellConfig cell, CellControllerParams params,
+                 RecordSink* sink);
+
+  /// Device time in seconds (the simulated cell's clock); robot durations are also measured in it.
+  void set_device_clock(std::function<double()> clock) { device_clock_ = std::move(clock); }
+  /// Ground truth the controller cannot see (the simulated cell's tube counts), added to each
+  /// record as truth_before / truth_after.
+  void set_annotator(std::function<nlohmann::json()> annotator) { annotator_ = std::move(annotator); }
+
+  /// Runs one bin. Never throws for device or planner failures: they end in a safe stop and a
+  /// kFault result.
+  CellRunResult Run(std::uint32_t round = 0);
+
+  /// The state the controller is in (kSafeStop after a fault).
+  CellState state() const { return state_; }
+
+ private:
+  struct Attempt;
+  enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed };
+
+  void StartCell();
+  /// ToolClearanceProblem for a plan (nullopt when the check is off or the tool stays clear).
+  std::optional<std::string> ClearanceProblem(const v1::PickPlan& plan, int rank) const;
+  void ExecutePlan(const v1::PlanPickResponse& response, int plan_index, Attempt& attempt);
+  void Place(const Eigen::Isometry3d& X_place, Attempt& attempt);
+  void ReturnToBin(const Eigen::Isometry3d& X_grasp, const Eigen::Isometry3d& X_lift, Attempt& attempt);
+  void OpenGripper();
+  v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,
+                                    const devices::WrenchReading& current, const Eigen::Isometry3d& X_lift,
+                                    Attempt& attempt);
+
+  // Devices, each call timed and its failures turned into CellFault.
+  devices::Capture Scan();
+  void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
+  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Attempt* attempt);
+  Eigen::Isometry3d CurrentPose();
+  /// Up to transit height, across, down to `X_BinTcp`.
+  void TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt);
+  devices::GripperStatus CheckGripper(const devices::GripperStatus& status);
+  devices::WrenchReading ReadWrench();
+
+  void SafeStop(const CellFault& fault, CellRunResult& result);
+  void Enter(CellState state);
+  nlohmann::json Truth() const;
+  double DeviceNow() const;
+
+  CellDevices devices_;
+  PlannerClient& planner_;
+  CellConfig cell_;
+  CellControllerParams params_;
+  RecordSink* sink_;
+  std::function<double()> device_clock_;
+  std::function<nlohmann::json()> annotator_;
+  CellState state_ = CellState::kStart;
+  std::uint32_t round_ = 0;
+};
+
+}  // namespace tubepick::cell

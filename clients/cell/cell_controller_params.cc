@@ -1,0 +1,80 @@
+#include "clients/cell/cell_controller_params.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "core/common/errors.h"
+
+namespace tubepick::cell {
+namespace {
+
+void RequirePositiveValue(double value, const char* field) {
+  if (!std::isfinite(value) || value <= 0.0)
+    throw InvalidArgument(fmt::format("cell controller {}: must be a positive number, got {}", field, value));
+}
+
+void RequireNonNegativeValue(double value, const char* field) {
+  if (!std::isfinite(value) || value < 0.0)
+    throw InvalidArgument(
+        fmt::format("cell controller {}: must be a non-negative number, got {}", field, value));
+}
+
+void RequirePositiveCount(std::uint64_t value, const char* field) {
+  if (value == 0) throw InvalidArgument(fmt::format("cell controller {}: must be at least 1, got 0", field));
+}
+
+void RequirePositiveDuration(std::chrono::milliseconds value, const char* field) {
+  if (value.count() <= 0)
+    throw InvalidArgument(
+        fmt::format("cell controller {}: must be positive, got {} ms", field, value.count()));
+}
+
+}  // namespace
+
+void CellControllerParams::Validate() const {
+  RequirePositiveValue(transit_speed, "transit_speed");
+  RequirePositiveValue(approach_speed, "approach_speed");
+  RequirePositiveValue(lift_speed, "lift_speed");
+  RequirePositiveValue(resolution_speed, "resolution_speed");
+  RequireNonNegativeValue(approach_height, "approach_height");
+  RequireNonNegativeValue(transit_clearance, "transit_clearance");
+  RequireNonNegativeValue(release_height, "release_height");
+  RequireNonNegativeValue(place_approach_height, "place_approach_height");
+  if (X_BinHome && !X_BinHome->matrix().allFinite())
+    throw InvalidArgument("cell controller X_BinHome: not finite");
+  if (!tool.finger_size.allFinite() || (tool.finger_size.array() <= 0.0).any() ||
+      !tool.housing_size.allFinite() || (tool.housing_size.array() < 0.0).any() ||
+      !std::isfinite(tool.finger_tip_depth) || !std::isfinite(tool.housing_gap) ||
+      !std::isfinite(tool.margin))
+    throw InvalidArgument("cell controller tool: sizes must be finite, finger sizes positive");
+  RequirePositiveValue(gripper_speed, "gripper_speed");
+  RequirePositiveValue(gripper_force, "gripper_force");
+  RequirePositiveCount(ft_samples, "ft_samples");
+  RequirePositiveCount(max_plans_per_scan, "max_plans_per_scan");
+  RequirePositiveDuration(plan_deadline, "plan_deadline");
+  RequirePositiveDuration(analyze_deadline, "analyze_deadline");
+  RequirePositiveCount(max_attempts_per_tube, "max_attempts_per_tube");
+  RequirePositiveCount(max_attempts_per_bin, "max_attempts_per_bin");
+  RequirePositiveCount(max_consecutive_failures, "max_consecutive_failures");
+  RequirePositiveDuration(scanner_timeout, "scanner_timeout");
+  RequirePositiveDuration(robot_timeout, "robot_timeout");
+  RequirePositiveDuration(gripper_timeout, "gripper_timeout");
+  RequirePositiveDuration(ft_timeout, "ft_timeout");
+}
+
+double TransitHeight(const CellControllerParams& params, const CellConfig& cell) {
+  return cell.bin.inner_size.z() + params.transit_clearance;
+}
+
+Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell) {
+  if (params.X_BinHome) return *params.X_BinHome;
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  // TCP z down (approach), x along the bin's x: a half turn about x_Bin.
+  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d p_place = cell.place.X_BinPlace.translation();
+  X.translation() = Eigen::Vector3d(p_place.x(), p_place.y(), TransitHeight(params, cell));
+  return X;
+}
+
+}  // namespace tubepick::cell

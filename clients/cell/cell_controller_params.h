@@ -1,0 +1,104 @@
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "clients/cell/tool_clearance.h"
+#include "core/common/cell_config.h"
+#include "devices/device_error.h"
+#include "tubepick/v1/wrench.pb.h"
+
+namespace tubepick::cell {
+
+/// Everything the cell controller decides by itself: speeds, heights, the planner options, the
+/// attempt limits and the timeouts. Every field has a default that suits the simulated cell and the
+/// thesis' setup (§5.3); poses are X_BinTcp (TCP in the bin frame, z down along the approach).
+struct CellControllerParams {
+  // --- motion ---
+  /// Free moves between poses (home, transit, above the place frame), m/s.
+  double transit_speed = 0.25;
+  /// Pre-grasp → grasp and above-place → place, m/s.
+  double approach_speed = 0.05;
+  /// Along the plan's waypoints after the grasp, m/s; the planner's trajectory simulation drives the
+  /// tube at the same speed (physics::TrajectorySimParams::gripper_speed, §5.2.3.2).
+  double lift_speed = 0.1;
+  /// Resolution rotations and the return to the lift pose, m/s of the TCP (the robot's speed unit).
+  double resolution_speed = 0.1;
+  /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
+  double approach_height = 0.10;
+  /// Transit moves happen at least this far above the bin's wall top, metres.
+  double transit_clearance = 0.30;
+  /// Several tubes that the resolution could not shake off are lowered back to this height above
+  /// the grasp point before the gripper opens, metres.
+  double release_height = 0.03;
+  /// The place pose is approached from this far above it, metres.
+  double place_approach_height = 0.10;
+  /// Where the robot waits while the bin is scanned (out of the scanner's view). Absent: above the
+  /// cell's placement frame at transit height, TCP pointing down.
+  std::optional<Eigen::Isometry3d> X_BinHome;
+
+  /// Plans whose tool path would touch a bin wall or the floor (ToolClearanceProblem) are skipped
+  /// before execution: a protective stop would end the round.
+  bool check_tool_clearance = true;
+  ToolGeometry tool;
+
+  // --- gripper ---
+  /// Closing speed (m/s) and force (N) (Robotiq 2F-85: 0.02-0.15 m/s, 20-235 N).
+  double gripper_speed = 0.1;
+  double gripper_force = 60.0;
+
+  // --- force/torque ---
+  /// Readings discarded before each F/T measurement: a wait for the payload to stop swinging
+  /// (the thesis' WaitSkill; the simulated sensor averages 0.05 s per reading).
+  std::uint32_t ft_settle_samples = 4;
+  /// Readings averaged for each F/T measurement (reference and after the lift).
+  std::uint32_t ft_samples = 5;
+
+  // --- planner ---
+  /// Parameter profile sent with PlanPick ("" = the server's).
+  std::string profile;
+  /// Seed of the first PlanPick; scan k sends seed + k, so a rescan of an unchanged bin can give
+  /// another model (RANSAC) and a run is still reproducible.
+  std::uint64_t seed = 1;
+  /// Plans requested per scan (0 = all); more plans leave alternatives when the best ones are
+  /// skipped by the tool clearance check.
+  std::uint32_t max_plans = 30;
+  /// Plans executed on one scan when grasps close on nothing (then rescan).
+  std::uint32_t max_plans_per_scan = 2;
+  bool disable_simulation = false;
+  /// Resolution rotation requested from AnalyzeWrench (UNSPECIFIED = the server's).
+  v1::ResolutionVariant resolution_variant = v1::RESOLUTION_VARIANT_UNSPECIFIED;
+  /// Per-try deadlines of the planner calls.
+  std::chrono::milliseconds plan_deadline{180'000};
+  std::chrono::milliseconds analyze_deadline{10'000};
+
+  // --- limits ---
+  /// Picking attempts (grasp executions) since the last successful pick.
+  std::uint32_t max_attempts_per_tube = 4;
+  /// Picking attempts in one run (one bin).
+  std::uint32_t max_attempts_per_bin = 60;
+  /// Consecutive scans or attempts that did not pick a tube (no plan, empty grasp, nothing or
+  /// several lifted).
+  std::uint32_t max_consecutive_failures = 6;
+
+  // --- timeouts ---
+  devices::Timeout scanner_timeout{30'000};
+  /// One robot motion (the longest: a lift of ~0.4 m at lift_speed, or a transit).
+  devices::Timeout robot_timeout{60'000};
+  devices::Timeout gripper_timeout{10'000};
+  devices::Timeout ft_timeout{2'000};
+
+  /// @throws InvalidArgument naming the first bad field and its value.
+  void Validate() const;
+};
+
+/// Home pose of `params` for `cell` (see CellControllerParams::X_BinHome).
+Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell);
+/// Height of transit moves in the bin frame: wall top + transit_clearance, metres.
+double TransitHeight(const CellControllerParams& params, const CellConfig& cell);
+
+}  // namespace tubepick::cell

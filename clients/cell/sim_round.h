@@ -1,0 +1,31 @@
+#pragma once
+
+#include <cstdint>
+
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_records.h"
+#include "clients/cell/planner_client.h"
+#include "devices/sim/sim_cell.h"
+
+namespace tubepick::cell {
+
+/// One closed-loop round in the simulated cell.
+struct SimRoundResult {
+  CellRunResult run;
+  /// Ground truth at the end: tubes still in the bin and outside it (placed or lost).
+  std::uint32_t tubes_in_bin = 0;
+  std::uint32_t tubes_outside_bin = 0;
+  /// Simulated seconds of the round and the wall time it took (cell construction included).
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+};
+
+/// Builds a SimCell from `sim_params`, runs the cell controller on it against `planner` until the
+/// bin is empty, a limit or a fault, and returns what happened. The controller sees the cell of
+/// `sim_params` (its tube radius, length and mass go to the planner), measures robot time in
+/// simulated seconds, and its records carry the simulation's ground truth as truth_before /
+/// truth_after / truth: {tubes_in_bin, tubes_outside_bin, held, sim_seconds}.
+SimRoundResult RunSimRound(PlannerClient& planner, const devices::sim::SimCellParams& sim_params,
+                           const CellControllerParams& params, std::uint32_t round, RecordSink* sink);
+
+}  // namespace tubepick::cell

@@ -1,0 +1,508 @@
+#include "clients/cell/cell_controller.h"
+
+#include <gtest/gtest.h>
+
+#include "clients/cell/test/scripted_cell.h"
+#include "core/common/errors.h"
+
+namespace tubepick::cell {
+namespace {
+
+using nlohmann::json;
+using testing::DownPose;
+using testing::Failure;
+using testing::MakePlan;
+using testing::Outcome;
+using testing::Plans;
+
+constexpr double kTol = 1e-9;
+
+devices::WrenchReading Reading(double fz, double mx = 0.0, double my = 0.0) {
+  devices::WrenchReading r;
+  r.force = Eigen::Vector3d(0.0, 0.0, fz);
+  r.torque = Eigen::Vector3d(mx, my, 0.0);
+  return r;
+}
+
+devices::GripperStatus ClosedOnNothing() {
+  devices::GripperStatus s;
+  s.activated = true;
+  s.object = devices::GripperObject::kAtPosition;
+  return s;
+}
+
+class CellControllerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    params.ft_samples = 1;
+    params.ft_settle_samples = 0;
+  }
+
+  CellRunResult Run() {
+    CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
+    return controller.Run(3);
+  }
+
+  std::vector<json> Records(const std::string& type) const {
+    std::vector<json> out;
+    for (const json& r : sink.records())
+      if (r.at("type") == type) out.push_back(r);
+    return out;
+  }
+
+  /// Waypoint `X` added to motion `m` of `response`.
+  static void AddWaypoint(v1::AnalyzeWrenchResponse& response, int m, const Eigen::Isometry3d& X) {
+    *response.mutable_resolution_motions(m)->add_waypoints()->mutable_tcp_pose() = ToWire(X);
+  }
+
+  testing::ScriptedScanner scanner;
+  testing::ScriptedRobot robot;
+  testing::ScriptedGripper gripper;
+  testing::ScriptedForceTorque ft;
+  testing::ScriptedPlanner planner;
+  MemoryRecordSink sink;
+  CellConfig cell;
+  CellControllerParams params;
+  const Eigen::Vector3d p_grasp{0.1, -0.05, 0.03};
+};
+
+TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.attempts, 0u);
+  EXPECT_EQ(result.scans, 1u);
+  EXPECT_TRUE(robot.servo_on);
+  EXPECT_EQ(gripper.activations, 1);
+  EXPECT_EQ(ft.biases, 1);
+  // The scan was taken from home: above the place frame at transit height (wall 0.2 + 0.3 m).
+  EXPECT_TRUE(robot.pose.isApprox(HomePose(params, cell), kTol));
+  EXPECT_NEAR(robot.pose.translation().z(), 0.5, kTol);
+  ASSERT_EQ(sink.records().size(), 1u);
+  const json& end = sink.records()[0];
+  EXPECT_EQ(end["type"], "end");
+  EXPECT_EQ(end["reason"], "bin_empty");
+  EXPECT_EQ(end["round"], 3);
+  EXPECT_EQ(end["picks"], 0);
+  // The request carried the cloud (2 points, 24 bytes) and the cell.
+  ASSERT_EQ(planner.plan_requests.size(), 1u);
+  EXPECT_EQ(planner.plan_requests[0].cloud().xyz().size(), 24u);
+  EXPECT_DOUBLE_EQ(planner.plan_requests[0].cell().tube_mass(), cell.tube.mass);
+  EXPECT_EQ(planner.plan_requests[0].options().seed(), params.seed);
+}
+
+TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_grasp)}, 1));
+  ft.readings = {Reading(0.10), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.attempts, 1u);
+  EXPECT_EQ(result.scans, 2u);
+
+  // Pre-grasp 0.1 m above, grasp, lift 0.4 m, place, back home.
+  const Eigen::Isometry3d X_grasp = DownPose(p_grasp);
+  EXPECT_TRUE(robot.Visited(DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.1))));
+  EXPECT_TRUE(robot.Visited(X_grasp));
+  EXPECT_TRUE(robot.Visited(DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.4))));
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
+  EXPECT_TRUE(robot.pose.isApprox(HomePose(params, cell), kTol));
+  EXPECT_EQ(gripper.openings, std::vector<double>{0.045});
+  EXPECT_TRUE(gripper.open);
+
+  // AnalyzeWrench got the reference (taken before the grasp), the reading after the lift and the
+  // lift pose.
+  ASSERT_EQ(planner.wrench_requests.size(), 1u);
+  const v1::AnalyzeWrenchRequest& w = planner.wrench_requests[0];
+  EXPECT_DOUBLE_EQ(w.reference().force().z(), 0.10);
+  EXPECT_DOUBLE_EQ(w.current().force().z(), 0.64);
+  EXPECT_DOUBLE_EQ(w.tube_mass(), cell.tube.mass);
+  EXPECT_NEAR(w.tcp_pose().position().z(), p_grasp.z() + 0.4, kTol);
+
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 1u);
+  const json& a = attempts[0];
+  EXPECT_EQ(a["round"], 3);
+  EXPECT_EQ(a["attempt"], 1);
+  EXPECT_EQ(a["tube"], 4);
+  EXPECT_EQ(a["tubes_left_plan"], 1);
+  EXPECT_EQ(a["trajectory_kind"], "upward");
+  EXPECT_EQ(a["used_simulation"], false);
+  EXPECT_EQ(a["gripper"]["object"], "stopped_closing");
+  EXPECT_EQ(a["analysis"]["outcome"], "single");
+  EXPECT_DOUBLE_EQ(a["wrench"]["reference"]["force"][2].get<double>(), 0.10);
+  EXPECT_DOUBLE_EQ(a["wrench"]["lift"]["force"][2].get<double>(), 0.64);
+  EXPECT_EQ(a["resolution"]["used"], 0);
+  EXPECT_EQ(a["result"], "picked");
+  EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_grasp.x());
+  EXPECT_GE(a["durations"]["planning_wall_s"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(a["durations"]["planning_server_s"].get<double>(), 0.5);
+  EXPECT_EQ(Records("end").at(0)["picks"], 1);
+}
+
+TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) {
+  const Eigen::Vector3d p_other(-0.2, 0.1, 0.02);
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp), MakePlan(2, p_other)}, 2));
+  gripper.close_results = {ClosedOnNothing()};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.attempts, 2u);
+  EXPECT_EQ(planner.plan_requests.size(), 2u);  // the second plan came from the first scan
+  EXPECT_EQ(gripper.closes, 2);
+  EXPECT_TRUE(robot.Visited(DownPose(p_other)));
+
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_EQ(attempts[0]["result"], "grasp_failed");
+  EXPECT_EQ(attempts[0]["gripper"]["object"], "at_position");
+  EXPECT_FALSE(attempts[0].contains("analysis"));
+  EXPECT_EQ(attempts[1]["result"], "picked");
+  EXPECT_EQ(attempts[1]["scan"], 0);
+  EXPECT_EQ(attempts[1]["plan_rank"], 1);
+  EXPECT_EQ(attempts[1]["tube"], 2);
+}
+
+TEST_F(CellControllerTest, NothingGraspedOnTheLastPlanRescans) {
+  params.max_plans_per_scan = 1;
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp), MakePlan(2, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  gripper.close_results = {ClosedOnNothing()};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.scans, 3u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_EQ(attempts[0]["result"], "grasp_failed");
+  EXPECT_EQ(attempts[1]["scan"], 1);
+  EXPECT_EQ(planner.plan_requests[1].options().seed(), params.seed + 1);  // a rescan gets a new seed
+}
+
+TEST_F(CellControllerTest, PlansTheToolCannotExecuteAreSkipped) {
+  // Tube 1 lies 0.25 m from the bin's centre along y: the 0.13 m wide housing would reach 0.315 m,
+  // past the +y wall at 0.30 m.
+  const Eigen::Vector3d p_wall(0.0, 0.25, 0.03);
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_wall), MakePlan(2, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_wall)}, 1));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.attempts, 1u);
+  EXPECT_FALSE(robot.Visited(DownPose(p_wall)));
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0]["tube"], 2);
+  EXPECT_EQ(records[0]["plan_rank"], 1);
+  ASSERT_EQ(records[0]["skipped_plans"].size(), 1u);
+  EXPECT_EQ(records[0]["skipped_plans"][0]["tube"], 1);
+  EXPECT_NE(records[0]["skipped_plans"][0]["reason"].get<std::string>().find("+y wall"), std::string::npos);
+  // The second scan has only the unreachable plan: no attempt, a no_plan record, a rescan.
+  EXPECT_EQ(records[1]["result"], "no_plan");
+  EXPECT_EQ(records[1]["skipped_plans"].size(), 1u);
+  EXPECT_EQ(result.scans, 3u);
+}
+
+TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 3));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_NONE, 0.05));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_EQ(result.scans, 2u);
+  EXPECT_TRUE(gripper.open);
+  EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));  // never went to place
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 1u);
+  EXPECT_EQ(attempts[0]["analysis"]["outcome"], "none");
+  EXPECT_EQ(attempts[0]["result"], "none");
+}
+
+TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
+  planner.plan_answers.push_back(
+      Plans({MakePlan(5, p_grasp, v1::TRAJECTORY_KIND_ESCAPE,
+                      {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.1, 0, 0.02),
+                       Eigen::Vector3d(0.1, 0, 0.42)})},
+            4, /*simulated=*/true));
+  const Eigen::Isometry3d X_lift = DownPose(p_grasp + Eigen::Vector3d(0.1, 0, 0.42));
+  Eigen::Isometry3d X_tilted = X_lift;
+  X_tilted.linear() =
+      X_lift.linear() * Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.1, 2);
+  AddWaypoint(multiple, 0, X_tilted);
+  AddWaypoint(multiple, 1, X_lift * Eigen::AngleAxisd(-M_PI / 4, Eigen::Vector3d::UnitX()));
+  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_SINGLE, 1.02)};
+  ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(0.66)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(X_tilted));
+  // After the rotation the TCP went back to the lift pose, then on to the place pose.
+  int tilted_index = -1;
+  for (std::size_t i = 0; i < robot.moves.size(); ++i)
+    if (robot.moves[i].target.isApprox(X_tilted, kTol)) tilted_index = static_cast<int>(i);
+  ASSERT_GE(tilted_index, 0);
+  EXPECT_TRUE(robot.moves[tilted_index + 1].target.isApprox(X_lift, kTol));
+  EXPECT_DOUBLE_EQ(robot.moves[tilted_index].speed, params.resolution_speed);
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
+  // The second analysis used the same reference and the new reading at the lift pose.
+  ASSERT_EQ(planner.wrench_requests.size(), 2u);
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[1].reference().force().z(), 0.1);
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[1].current().force().z(), 0.66);
+
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["trajectory_kind"], "escape");
+  EXPECT_EQ(a["used_simulation"], true);
+  EXPECT_EQ(a["analysis"]["outcome"], "multiple");
+  EXPECT_EQ(a["resolution"]["available"], 2);
+  EXPECT_EQ(a["resolution"]["used"], 1);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+  ASSERT_EQ(a["wrench"]["after_resolution"].size(), 1u);
+  EXPECT_EQ(a["wrench"]["after_resolution"][0]["outcome"], "single");
+  EXPECT_DOUBLE_EQ(a["wrench"]["lift"]["torque"][0].get<double>(), 0.03);
+  EXPECT_EQ(a["result"], "picked");
+}
+
+TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_grasp)}, 4));
+  const Eigen::Isometry3d X_lift = DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.4));
+  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
+  AddWaypoint(multiple, 0, X_lift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
+  AddWaypoint(multiple, 1, X_lift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
+  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0),
+                            Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_EQ(result.scans, 2u);
+  EXPECT_EQ(planner.wrench_requests.size(), 3u);
+  // Lowered straight down to release_height above the grasp point, opened, back up.
+  bool lowered = false;
+  for (const testing::ScriptedRobot::Move& m : robot.moves)
+    if (m.through &&
+        m.target.isApprox(DownPose(p_grasp + Eigen::Vector3d(0, 0, params.release_height)), kTol))
+      lowered = true;
+  EXPECT_TRUE(lowered);
+  EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
+  EXPECT_TRUE(gripper.open);
+
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["resolution"]["succeeded"], false);
+  EXPECT_EQ(a["wrench"]["after_resolution"].size(), 2u);
+  EXPECT_EQ(a["result"], "multiple_returned");
+}
+
+TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
+  params.max_attempts_per_tube = 3;
+  params.max_plans_per_scan = 1;
+  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  for (int i = 0; i < 5; ++i) gripper.close_results.push_back(ClosedOnNothing());
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
+  EXPECT_EQ(result.attempts, 3u);
+  EXPECT_NE(result.message.find("max_attempts_per_tube = 3"), std::string::npos) << result.message;
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 3u);
+  for (const json& a : attempts) EXPECT_EQ(a["result"], "grasp_failed");
+  const json end = Records("end").at(0);
+  EXPECT_EQ(end["reason"], "limit_reached");
+  EXPECT_EQ(end["message"], result.message);
+  EXPECT_TRUE(Records("safe_stop").empty());
+}
+
+TEST_F(CellControllerTest, ScansWithoutPlanCountAsConsecutiveFailures) {
+  params.max_consecutive_failures = 2;
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({}, 1));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
+  EXPECT_EQ(result.attempts, 0u);
+  EXPECT_NE(result.message.find("2 consecutive failures"), std::string::npos) << result.message;
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[0]["result"], "no_plan");
+  EXPECT_TRUE(records[0]["attempt"].is_null());
+}
+
+TEST_F(CellControllerTest, PerBinLimitCountsAllAttempts) {
+  params.max_attempts_per_bin = 2;
+  for (int i = 0; i < 3; ++i) {
+    planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 3));
+    planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  }
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
+  EXPECT_EQ(result.picks, 2u);
+  EXPECT_NE(result.message.find("max_attempts_per_bin = 2"), std::string::npos) << result.message;
+}
+
+// ---------------------------------------------------------------- faults
+
+TEST_F(CellControllerTest, ScannerTimeoutEndsInSafeStop) {
+  scanner.failures = {Failure{true, "PhoXi: no frame within 30000 ms"}};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kFault);
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "scanner");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kTimeout);
+  EXPECT_EQ(result.fault->state(), "scan");
+  EXPECT_TRUE(result.gripper_opened);
+  EXPECT_TRUE(result.moved_up);
+  EXPECT_EQ(
+      result.message.rfind("SAFE STOP: scanner timeout during scan: PhoXi: no frame within 30000 ms", 0), 0u)
+      << result.message;
+  const json stop = Records("safe_stop").at(0);
+  EXPECT_EQ(stop["device"], "scanner");
+  EXPECT_EQ(stop["kind"], "timeout");
+  EXPECT_EQ(stop["gripper_opened"], true);
+  EXPECT_EQ(Records("end").at(0)["reason"], "fault");
+  EXPECT_TRUE(Records("attempt").empty());
+}
+
+TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) {
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  devices::GripperStatus fault;
+  fault.activated = true;
+  fault.fault = 0x08;
+  fault.fault_text = "overcurrent";
+  gripper.close_results = {fault};
+  const int opens_before_stop = 1;  // the start opens once
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kFault);
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "gripper");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kDeviceFault);
+  EXPECT_EQ(result.fault->state(), "grasp");
+  EXPECT_NE(result.message.find("fault 0x08: overcurrent"), std::string::npos) << result.message;
+  EXPECT_EQ(gripper.opens, opens_before_stop + 1);
+  EXPECT_TRUE(gripper.open);
+  // The robot was at the grasp pose in the bin; the safe stop moved it straight up to transit height.
+  EXPECT_NEAR(robot.pose.translation().z(), 0.5, kTol);
+  EXPECT_NEAR(robot.pose.translation().x(), p_grasp.x(), kTol);
+  EXPECT_NE(result.message.find("robot moved up to z = 0.500 m"), std::string::npos) << result.message;
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "fault");
+  EXPECT_EQ(a["fault"]["device"], "gripper");
+  EXPECT_EQ(a["fault"]["state"], "grasp");
+}
+
+TEST_F(CellControllerTest, RobotFaultDuringLiftEndsInSafeStopEvenWhenTheRobotCannotMove) {
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  robot.fail_through_from = 0;
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kFault);
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "robot");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kDeviceFault);
+  EXPECT_EQ(result.fault->state(), "lift");
+  EXPECT_TRUE(result.gripper_opened);  // the tube is released where it lies
+  EXPECT_FALSE(result.moved_up);
+  EXPECT_NE(result.message.find("YRC1000 alarm 4107"), std::string::npos);
+  EXPECT_NE(result.message.find("robot could not move up"), std::string::npos) << result.message;
+  EXPECT_EQ(Records("attempt").at(0)["fault"]["device"], "robot");
+  EXPECT_EQ(Records("safe_stop").at(0)["moved_up"], false);
+}
+
+TEST_F(CellControllerTest, ForceTorqueTimeoutAfterLiftEndsInSafeStop) {
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  ft.fail_read_from = 1;  // the reference works, the reading after the lift does not
+
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kTimeout);
+  EXPECT_EQ(result.fault->state(), "analyze");
+  EXPECT_TRUE(result.gripper_opened);
+  EXPECT_EQ(result.message.rfind("SAFE STOP: ft_sensor timeout during analyze", 0), 0u) << result.message;
+  EXPECT_TRUE(planner.wrench_requests.empty());
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "fault");
+  EXPECT_EQ(a["gripper"]["object"], "stopped_closing");
+}
+
+TEST_F(CellControllerTest, PlannerUnavailableEndsInSafeStop) {
+  testing::ScriptedPlanner::PlanAnswer down;
+  down.error =
+      PlannerError("PlanPick", grpc::StatusCode::UNAVAILABLE, "failed to connect to all addresses", 4);
+  planner.plan_answers.push_back(down);
+
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "planner");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kServerUnavailable);
+  EXPECT_EQ(result.fault->state(), "plan");
+  EXPECT_NE(result.message.find("PlanPick failed after 4 tries: UNAVAILABLE: failed to connect"),
+            std::string::npos)
+      << result.message;
+  EXPECT_TRUE(result.gripper_opened);
+  EXPECT_EQ(Records("safe_stop").at(0)["kind"], "server_unavailable");
+}
+
+TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
+  GrpcPlannerClientOptions options;
+  options.max_retries = 2;
+  options.initial_backoff = std::chrono::milliseconds(5);
+  options.max_backoff = std::chrono::milliseconds(10);
+  GrpcPlannerClient client("127.0.0.1:1", options);  // nothing listens on port 1
+  CellController controller({&scanner, &robot, &gripper, &ft}, client, cell, params, &sink);
+
+  const CellRunResult result = controller.Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->kind(), FaultKind::kServerUnavailable);
+  EXPECT_NE(result.message.find("PlanPick failed after 3 tries: UNAVAILABLE"), std::string::npos)
+      << result.message;
+  EXPECT_EQ(controller.state(), CellState::kSafeStop);
+}
+
+TEST_F(CellControllerTest, SafeStopSaysSoWhenTheGripperCannotOpen) {
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  robot.fail_through_from = 0;
+  gripper.fail_open_from = 1;  // the start's open works
+
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_FALSE(result.gripper_opened);
+  EXPECT_NE(result.message.find("gripper could not be opened (Robotiq 2F-85: no Modbus reply"),
+            std::string::npos)
+      << result.message;
+  EXPECT_EQ(Records("safe_stop").at(0)["gripper_opened"], false);
+}
+
+TEST_F(CellControllerTest, UnusablePlanIsAServerError) {
+  v1::PickPlan plan = MakePlan(1, p_grasp);
+  plan.clear_waypoints();
+  planner.plan_answers.push_back(Plans({plan}, 1));
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->kind(), FaultKind::kServerError);
+  EXPECT_NE(result.message.find("plans[0].waypoints: empty"), std::string::npos) << result.message;
+}
+
+TEST(CellControllerParamsTest, InvalidValuesNameTheField) {
+  CellControllerParams params;
+  params.lift_speed = -0.1;
+  try {
+    params.Validate();
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("lift_speed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("-0.1"), std::string::npos) << e.what();
+  }
+  params = CellControllerParams{};
+  params.max_attempts_per_tube = 0;
+  EXPECT_THROW(params.Validate(), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace tubepick::cell

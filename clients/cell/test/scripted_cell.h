@@ -1,0 +1,242 @@
+#pragma once
+
+// Scripted devices and a scripted planner for the cell controller's state-machine tests: hardware
+// cannot run in CI, so each fake answers from a queue the test fills and records what it was asked.
+
+#include <deque>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "clients/cell/planner_client.h"
+#include "clients/cell/wire_convert.h"
+#include "devices/force_torque_sensor.h"
+#include "devices/gripper.h"
+#include "devices/robot.h"
+#include "devices/scanner.h"
+
+namespace tubepick::cell::testing {
+
+/// A failure a fake throws: a timeout or a device fault with a message.
+struct Failure {
+  bool timeout = false;
+  std::string message;
+  [[noreturn]] void Throw() const {
+    if (timeout) throw devices::DeviceTimeout(message);
+    throw devices::DeviceFault(message);
+  }
+};
+
+class ScriptedScanner final : public devices::Scanner {
+ public:
+  /// Failures by call index (0-based); other calls return a few points.
+  std::vector<std::optional<Failure>> failures;
+  int calls = 0;
+
+  devices::Capture Scan(devices::Timeout) override {
+    const int i = calls++;
+    if (i < static_cast<int>(failures.size()) && failures[i]) failures[i]->Throw();
+    devices::Capture c;
+    c.points_Sensor = {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.01f, 0.f, 1.f)};
+    return c;
+  }
+};
+
+/// The robot: follows every command exactly (CurrentPose is the last target) and logs it.
+class ScriptedRobot final : public devices::Robot {
+ public:
+  struct Move {
+    bool through = false;  ///< MoveThrough (else MoveTo)
+    Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+    std::vector<Eigen::Vector3d> waypoints;
+    double speed = 0.0;
+  };
+  Eigen::Isometry3d pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 1.0));
+  std::vector<Move> moves;
+  bool servo_on = false;
+  /// Fails every MoveThrough from the n-th on (0-based), or every motion when fail_always.
+  std::optional<int> fail_through_from;
+  bool fail_always = false;
+  Failure failure{false, "YRC1000 alarm 4107: out of range (joint T)"};
+  int throughs = 0;
+
+  void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, devices::Timeout) override {
+    if (fail_always) failure.Throw();
+    moves.push_back({false, X_BinTcp, {}, speed});
+    pose = X_BinTcp;
+  }
+  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, devices::Timeout) override {
+    const int i = throughs++;
+    if (fail_always || (fail_through_from && i >= *fail_through_from)) {
+      fail_always = true;  // a robot in alarm refuses every further motion
+      failure.Throw();
+    }
+    Eigen::Isometry3d target = pose;
+    target.translation() += waypoints.back();
+    moves.push_back({true, target, waypoints, speed});
+    pose = target;
+  }
+  Eigen::Isometry3d CurrentPose(devices::Timeout) override { return pose; }
+  void ServoOn(devices::Timeout) override { servo_on = true; }
+
+  /// Whether some MoveTo / MoveThrough ended at `X` (within 1e-9).
+  bool Visited(const Eigen::Isometry3d& X) const {
+    for (const Move& m : moves)
+      if (m.target.isApprox(X, 1e-9)) return true;
+    return false;
+  }
+};
+
+class ScriptedGripper final : public devices::Gripper {
+ public:
+  /// What each Close reports, in order; when empty, an object is held.
+  std::deque<devices::GripperStatus> close_results;
+  /// Open fails with this from the n-th call on (0-based).
+  std::optional<int> fail_open_from;
+  Failure open_failure{true, "Robotiq 2F-85: no Modbus reply within 10000 ms"};
+  int activations = 0, opens = 0, closes = 0, moves = 0;
+  bool open = false;
+  std::vector<double> openings;
+
+  void Activate(devices::Timeout) override { ++activations; }
+  devices::GripperStatus MoveTo(double opening, double, double, devices::Timeout) override {
+    ++moves;
+    openings.push_back(opening);
+    return Status({});
+  }
+  devices::GripperStatus Open(devices::Timeout) override {
+    const int i = opens++;
+    if (fail_open_from && i >= *fail_open_from) open_failure.Throw();
+    open = true;
+    devices::GripperStatus s = Status({});
+    s.opening = 0.085;
+    return s;
+  }
+  devices::GripperStatus Close(double, double, devices::Timeout) override {
+    ++closes;
+    open = false;
+    devices::GripperStatus s;
+    s.activated = true;
+    s.object = devices::GripperObject::kStoppedClosing;
+    s.opening = 0.025;
+    if (!close_results.empty()) {
+      s = close_results.front();
+      close_results.pop_front();
+    }
+    return s;
+  }
+  devices::GripperStatus Status(devices::Timeout) override {
+    devices::GripperStatus s;
+    s.activated = activations > 0;
+    s.object = devices::GripperObject::kAtPosition;
+    return s;
+  }
+};
+
+class ScriptedForceTorque final : public devices::ForceTorqueSensor {
+ public:
+  /// Readings in order; when empty, zero.
+  std::deque<devices::WrenchReading> readings;
+  /// Reads fail from the n-th call on (0-based).
+  std::optional<int> fail_read_from;
+  Failure failure{true, "ATI Net F/T: no RDT packet within 2000 ms"};
+  int biases = 0, reads = 0;
+
+  devices::WrenchReading Read(devices::Timeout) override {
+    const int i = reads++;
+    if (fail_read_from && i >= *fail_read_from) failure.Throw();
+    if (readings.empty()) return {};
+    devices::WrenchReading r = readings.front();
+    readings.pop_front();
+    return r;
+  }
+  void Bias(devices::Timeout) override { ++biases; }
+};
+
+/// Answers from queues; a queued PlannerError is thrown instead of answering.
+class ScriptedPlanner final : public PlannerClient {
+ public:
+  struct PlanAnswer {
+    v1::PlanPickResponse response;
+    std::optional<PlannerError> error;
+  };
+  std::deque<PlanAnswer> plan_answers;
+  std::deque<v1::AnalyzeWrenchResponse> wrench_answers;
+  std::vector<v1::PlanPickRequest> plan_requests;
+  std::vector<v1::AnalyzeWrenchRequest> wrench_requests;
+
+  v1::PlanPickResponse PlanPick(const v1::PlanPickRequest& request, std::chrono::milliseconds) override {
+    plan_requests.push_back(request);
+    if (plan_answers.empty()) {  // nothing scripted: the bin is empty
+      v1::PlanPickResponse empty;
+      empty.set_bin_empty(true);
+      return empty;
+    }
+    PlanAnswer a = plan_answers.front();
+    plan_answers.pop_front();
+    if (a.error) throw *a.error;
+    return a.response;
+  }
+  v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
+                                          std::chrono::milliseconds) override {
+    wrench_requests.push_back(request);
+    if (wrench_answers.empty())
+      throw PlannerError("AnalyzeWrench", grpc::StatusCode::INTERNAL, "unscripted", 1);
+    v1::AnalyzeWrenchResponse a = wrench_answers.front();
+    wrench_answers.pop_front();
+    return a;
+  }
+};
+
+/// TCP pointing down (z_Tcp = -z_Bin) at `p`.
+inline Eigen::Isometry3d DownPose(const Eigen::Vector3d& p) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  X.translation() = p;
+  return X;
+}
+
+/// A plan for `tube` grasped at `p_grasp`, lifted along `waypoints` (default straight up 0.4 m).
+inline v1::PickPlan MakePlan(std::uint32_t tube, const Eigen::Vector3d& p_grasp,
+                             v1::TrajectoryKind kind = v1::TRAJECTORY_KIND_UPWARD,
+                             std::vector<Eigen::Vector3d> waypoints = {Eigen::Vector3d::Zero(),
+                                                                       Eigen::Vector3d(0, 0, 0.4)}) {
+  v1::PickPlan plan;
+  plan.set_tube_id(tube);
+  *plan.mutable_grasp()->mutable_tcp_pose() = ToWire(DownPose(p_grasp));
+  *plan.mutable_grasp()->mutable_approach() = ToWire(Eigen::Vector3d(0, 0, -1));
+  plan.mutable_grasp()->set_opening_width(0.045);
+  for (const Eigen::Vector3d& w : waypoints) *plan.add_waypoints() = ToWire(w);
+  plan.set_trajectory_kind(kind);
+  plan.mutable_cost()->set_total(0.1 * tube);
+  *plan.mutable_place_tcp_pose() = ToWire(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12)));
+  return plan;
+}
+
+/// A PlanPick answer with these plans, `tubes` modeled tubes.
+inline ScriptedPlanner::PlanAnswer Plans(std::vector<v1::PickPlan> plans, int tubes, bool simulated = false) {
+  ScriptedPlanner::PlanAnswer a;
+  for (v1::PickPlan& p : plans) *a.response.add_plans() = p;
+  for (int i = 0; i < tubes; ++i) a.response.add_tubes()->set_id(i);
+  a.response.set_used_simulation(simulated);
+  a.response.set_total_seconds(0.5);
+  return a;
+}
+
+inline v1::AnalyzeWrenchResponse Outcome(v1::HeldOutcome outcome, double ratio, int motions = 0) {
+  v1::AnalyzeWrenchResponse r;
+  r.set_outcome(outcome);
+  r.set_tube_ratio(ratio);
+  r.set_estimated_count(outcome == v1::HELD_OUTCOME_NONE ? 0 : outcome == v1::HELD_OUTCOME_SINGLE ? 1 : 2);
+  for (int m = 0; m < motions; ++m) {
+    v1::ResolutionMotion* motion = r.add_resolution_motions();
+    motion->set_angle(m == 0 ? M_PI / 4 : -M_PI / 4);
+    motion->set_description(m == 0 ? "+45 deg" : "-45 deg");
+  }
+  return r;
+}
+
+}  // namespace tubepick::cell::testing

@@ -1,0 +1,181 @@
+#include "clients/cli/cell_command.h"
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <fstream>
+#include <memory>
+
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_records.h"
+#include "clients/cell/cell_statistics.h"
+#include "clients/cell/planner_client.h"
+#include "clients/cell/sim_round.h"
+#include "clients/cli/cell_server_process.h"
+#include "clients/cli/cell_tables.h"
+#include "core/common/errors.h"
+#include "devices/sim/sim_cell.h"
+
+namespace tubepick::cli {
+namespace {
+
+using nlohmann::json;
+
+struct CellOptions {
+  bool sim = false;
+  std::uint32_t rounds = 1;
+  std::uint32_t tubes = 7;
+  std::string material = "pvc";
+  std::string server = "auto";
+  std::uint64_t seed = 1;
+  std::string records_path;
+  std::string json_path;
+  std::string profile;
+  std::string resolution;
+  bool no_sim_planning = false;
+  double plan_deadline = 300.0;
+  std::uint32_t max_attempts_per_tube = 0;
+};
+
+v1::ResolutionVariant ParseVariant(const std::string& name) {
+  if (name.empty()) return v1::RESOLUTION_VARIANT_UNSPECIFIED;
+  if (name == "torque_axis") return v1::RESOLUTION_VARIANT_TORQUE_AXIS;
+  if (name == "torque_axis_negative") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE;
+  if (name == "perpendicular") return v1::RESOLUTION_VARIANT_PERPENDICULAR;
+  if (name == "joint_safe") return v1::RESOLUTION_VARIANT_JOINT_SAFE;
+  throw InvalidArgument(
+      fmt::format("--resolution: unknown variant \"{}\" (torque_axis, torque_axis_negative, "
+                  "perpendicular, joint_safe)",
+                  name));
+}
+
+void Run(const CellOptions& o) {
+  if (!o.sim)
+    throw InvalidArgument(
+        "--sim is required: the cell command drives the simulated cell (the real drivers "
+        "in devices/ are not wired to this command yet)");
+  if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
+  if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
+  if (!(o.plan_deadline > 0.0))
+    throw InvalidArgument(fmt::format("--plan-deadline: must be positive, got {}", o.plan_deadline));
+  const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
+  const v1::ResolutionVariant variant = ParseVariant(o.resolution);
+
+  std::unique_ptr<ServerProcess> server;
+  std::string address = o.server;
+  if (o.server == "auto") {
+    server =
+        ServerProcess::Start(SiblingExecutable("tubepick-server"),
+                             {"--address", "127.0.0.1:0", "--metrics-address", "", "--log-level", "info"},
+                             std::chrono::seconds(60));
+    address = server->address();
+    fmt::print("planner: started tubepick-server (pid {}) on {}\n", server->pid(), address);
+  } else {
+    fmt::print("planner: {}\n", address);
+  }
+  cell::GrpcPlannerClient planner(address);
+
+  cell::MemoryRecordSink memory;
+  std::unique_ptr<cell::JsonLinesFileSink> file;
+  if (!o.records_path.empty()) file = std::make_unique<cell::JsonLinesFileSink>(o.records_path);
+  cell::TeeRecordSink sink(&memory, file.get());
+
+  json rounds_json = json::array();
+  bool any_fault = false;
+  for (std::uint32_t round = 0; round < o.rounds; ++round) {
+    cell::CellControllerParams params;
+    params.seed = (o.seed + round) * 1000;
+    params.profile = o.profile;
+    params.disable_simulation = o.no_sim_planning;
+    params.resolution_variant = variant;
+    params.plan_deadline = std::chrono::milliseconds(static_cast<std::int64_t>(o.plan_deadline * 1000.0));
+    if (o.max_attempts_per_tube > 0) params.max_attempts_per_tube = o.max_attempts_per_tube;
+    const cell::SimRoundResult r =
+        cell::RunSimRound(planner, devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round),
+                          params, round, &sink);
+    const cell::CellRunResult& result = r.run;
+    const std::uint32_t left = r.tubes_in_bin;
+    const double wall = r.wall_s;
+    fmt::print(
+        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} attempts, {} scans, {:.0f} s "
+        "simulated, "
+        "{:.0f} s wall\n",
+        round, o.seed + round, result.message, result.picks, left, result.attempts, result.scans,
+        r.simulated_s, wall);
+    std::fflush(stdout);
+    rounds_json.push_back({{"round", round},
+                           {"seed", o.seed + round},
+                           {"reason", cell::ToString(result.reason)},
+                           {"message", result.message},
+                           {"picks", result.picks},
+                           {"tubes_left", left},
+                           {"attempts", result.attempts},
+                           {"scans", result.scans},
+                           {"simulated_s", r.simulated_s},
+                           {"wall_s", wall}});
+    if (result.reason == cell::CellStopReason::kFault) {
+      any_fault = true;
+      if (result.fault && result.fault->kind() == cell::FaultKind::kServerUnavailable) {
+        fmt::print("planner unavailable: the remaining rounds are skipped\n");
+        break;
+      }
+    }
+  }
+
+  const cell::CellStatistics stats = cell::SummarizeRecords(memory.records());
+  fmt::print("\n{}", FormatCellTables(
+                         stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
+                                            stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
+  if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", o.json_path));
+    out << json{{"material", o.material},
+                {"tubes", o.tubes},
+                {"seed", o.seed},
+                {"rounds", rounds_json},
+                {"statistics", cell::StatisticsJson(stats)}}
+               .dump(2)
+        << '\n';
+    fmt::print("wrote {}\n", o.json_path);
+  }
+  if (server) {
+    const int status = server->Stop(std::chrono::seconds(15));
+    spdlog::info("tubepick-server exited with status {}", status);
+  }
+  if (any_fault) throw CLI::RuntimeError(3);
+}
+
+}  // namespace
+
+void AddCellCommand(CLI::App& app) {
+  auto o = std::make_shared<CellOptions>();
+  CLI::App* cmd =
+      app.add_subcommand("cell", "Run bin-picking rounds in the simulated cell (thesis Tables 5.4-5.9)");
+  cmd->add_flag("--sim", o->sim, "Use the simulated cell (Bullet world behind all four devices)");
+  cmd->add_option("--rounds", o->rounds, "Rounds (bins) to run; round r uses seed + r")
+      ->capture_default_str();
+  cmd->add_option("--tubes", o->tubes, "Tubes dropped into the bin per round")->capture_default_str();
+  cmd->add_option("--material", o->material, "pvc (set A) or rubber (set B), thesis Table 5.2")
+      ->capture_default_str();
+  cmd->add_option("--server", o->server,
+                  "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the first round's cell and the planner seeds")
+      ->capture_default_str();
+  cmd->add_option("--records", o->records_path, "Write every attempt as a JSON line to this file");
+  cmd->add_option("--json", o->json_path, "Write the per-round results and the statistics as JSON");
+  cmd->add_option("--profile", o->profile, "Planner parameter profile (fast, thesis; default: the server's)");
+  cmd->add_option("--resolution", o->resolution,
+                  "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe "
+                  "(default: the server's)");
+  cmd->add_flag("--no-sim-planning", o->no_sim_planning, "Ask the planner not to simulate trajectories");
+  cmd->add_option("--plan-deadline", o->plan_deadline, "PlanPick deadline per try, seconds")
+      ->capture_default_str();
+  cmd->add_option("--max-attempts-per-tube", o->max_attempts_per_tube,
+                  "Attempts since the last pick before the round stops (0 = controller default)");
+  cmd->callback([o] { Run(*o); });
+}
+
+}  // namespace tubepick::cli

@@ -1,0 +1,13 @@
+# The cell controller end to end (unit tests of the state machine: clients/cell/test):
+# - cell_e2e_test: a real in-process PlannerServer, the gRPC client and the simulated cell;
+# - cell_cli_test: `tubepick cell --sim` starting tubepick-server itself (--server auto).
+if(TARGET tubepick_cell AND TARGET tubepick_devices_sim)
+  tubepick_add_test(cell_e2e_test SOURCES cell_e2e_test.cc LIBS tubepick_cell tubepick_server)
+  target_include_directories(cell_e2e_test PRIVATE ${PROJECT_SOURCE_DIR})
+endif()
+if(TARGET tubepick-server)
+  tubepick_add_test(cell_cli_test SOURCES cell_cli_test.cc LIBS nlohmann_json::nlohmann_json)
+  target_include_directories(cell_cli_test PRIVATE ${PROJECT_SOURCE_DIR})
+  add_dependencies(cell_cli_test tubepick tubepick-server)
+  target_compile_definitions(cell_cli_test PRIVATE TUBEPICK_CLI="$<TARGET_FILE:tubepick>")
+endif()
