@@ -4,10 +4,14 @@
 #include <CLI/CLI.hpp>
 
 #include "clients/cli/bench_command.h"
+#include "clients/cli/cell_command.h"
 #include "clients/cli/eval_command.h"
+#include "clients/cli/health_command.h"
+#include "clients/cli/load_command.h"
 #include "clients/cli/model_command.h"
 #include "clients/cli/params_command.h"
 #include "clients/cli/plan_command.h"
+#include "clients/cli/request_command.h"
 #include "clients/cli/scene_command.h"
 #include "core/common/errors.h"
 
@@ -23,6 +27,10 @@ int main(int argc, char** argv) {
   tubepick::cli::AddBenchCommand(app);
   tubepick::cli::AddSceneCommand(app);
   tubepick::cli::AddEvalCommand(app);
+  tubepick::cli::AddCellCommand(app);
+  tubepick::cli::AddLoadCommand(app);
+  tubepick::cli::AddHealthCommand(app);
+  tubepick::cli::AddRequestCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

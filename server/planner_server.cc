@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "grpc/health/v1/health.pb.h"
 #include "server/metrics.h"
 #include "server/metrics_http.h"
 #include "server/planner_service.h"
@@ -100,6 +101,10 @@ void PlannerServer::Start() {
     grpc::EnableDefaultHealthCheckService(true);
     grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   });
+  // gRPC's health service is not protobuf-generated, so reflection cannot describe it unless its
+  // descriptor is in the generated pool: referencing it links health.pb.o and registers it, and
+  // `buf curl .../grpc.health.v1.Health/Check` works without a local schema.
+  (void)grpc::health::v1::HealthCheckRequest::descriptor();
 
   m.metrics = std::make_unique<Metrics>();
   m.pool = std::make_unique<WorkerPool>(WorkerCount(config), config.queue_capacity);

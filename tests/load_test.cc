@@ -1,0 +1,281 @@
+// The load tool (clients/cli/load_engine.h) and the health check (health_command.h) against a real
+// PlannerServer in-process on loopback: counts, percentile order, errors counted by status code, RSS
+// sampling from the real metrics endpoint.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "clients/cli/builtin_scene.h"
+#include "clients/cli/health_command.h"
+#include "clients/cli/load_engine.h"
+#include "clients/cli/load_metrics.h"
+#include "core/common/errors.h"
+#include "core/modeling/cloud_io.h"
+#include "server/planner_server.h"
+#include "server/server_config.h"
+
+namespace tubepick::cli {
+namespace {
+
+constexpr double kTol = 1e-12;
+
+/// Loopback server: gRPC and metrics on free ports, `workers` workers, queue `queue`.
+class LocalServer {
+ public:
+  LocalServer(std::uint32_t workers, std::uint32_t queue) {
+    server::ServerConfig config;
+    config.address = "127.0.0.1:0";
+    config.metrics_address = "127.0.0.1:0";
+    config.workers = workers;
+    config.queue_capacity = queue;
+    config.log_level = "warn";
+    server_ = std::make_unique<server::PlannerServer>(config);
+    server_->Start();
+  }
+  ~LocalServer() { server_->Shutdown(std::chrono::milliseconds(0)); }
+  std::string target() const { return "127.0.0.1:" + std::to_string(server_->port()); }
+  std::string metrics_url() const {
+    return "http://127.0.0.1:" + std::to_string(server_->metrics_port()) + "/metrics";
+  }
+
+ private:
+  std::unique_ptr<server::PlannerServer> server_;
+};
+
+/// Three generated tubes in the default bin, every `every`-th scanner return (2.3 M points at 1).
+const Points& SceneCloud(std::uint32_t every) {
+  static const BuiltInScene scene = MakeBuiltInScene(CellConfig{}, 3, /*seed=*/7);
+  static std::map<std::uint32_t, Points> thinned;
+  Points& points = thinned[every];
+  if (points.empty())
+    for (std::size_t i = 0; i < scene.points_Sensor.size(); i += every)
+      points.push_back(scene.points_Sensor[i]);
+  return points;
+}
+
+LoadCloud GoodCloud() { return {"scene", PackCloudXyz(SceneCloud(20)), v1::LENGTH_UNIT_METRE}; }
+/// 13 bytes: not a whole number of points, which the server must answer INVALID_ARGUMENT.
+LoadCloud BadCloud() { return {"bad", std::string(13, '\x01'), v1::LENGTH_UNIT_METRE}; }
+
+void ExpectOrdered(const LatencySummary& l) {
+  EXPECT_GT(l.min, 0.0);
+  EXPECT_LE(l.min, l.p50);
+  EXPECT_LE(l.p50, l.p90);
+  EXPECT_LE(l.p90, l.p95);
+  EXPECT_LE(l.p95, l.p99);
+  EXPECT_LE(l.p99, l.max);
+  EXPECT_GE(l.mean, l.min);
+  EXPECT_LE(l.mean, l.max);
+}
+
+TEST(LoadEngine, PackCloudXyzIsLittleEndianFloat32) {
+  const Points points = {Eigen::Vector3f(1.0f, -2.5f, 0.125f)};
+  const std::string xyz = PackCloudXyz(points);
+  ASSERT_EQ(xyz.size(), 12u);
+  // 1.0f = 0x3F800000, stored least significant byte first.
+  EXPECT_EQ(static_cast<unsigned char>(xyz[0]), 0x00);
+  EXPECT_EQ(static_cast<unsigned char>(xyz[3]), 0x3F);
+  EXPECT_EQ(static_cast<unsigned char>(xyz[2]), 0x80);
+  float y = 0.0f;
+  std::memcpy(&y, xyz.data() + 4, 4);
+  EXPECT_EQ(y, -2.5f);
+}
+
+TEST(LoadEngine, SummarizeLatencyNearestRank) {
+  std::vector<double> seconds;
+  for (int i = 100; i >= 1; --i) seconds.push_back(i / 100.0);  // 0.01 .. 1.00, reversed
+  const LatencySummary s = SummarizeLatency(seconds);
+  EXPECT_NEAR(s.min, 0.01, kTol);
+  EXPECT_NEAR(s.p50, 0.50, kTol);
+  EXPECT_NEAR(s.p90, 0.90, kTol);
+  EXPECT_NEAR(s.p95, 0.95, kTol);
+  EXPECT_NEAR(s.p99, 0.99, kTol);
+  EXPECT_NEAR(s.max, 1.00, kTol);
+  EXPECT_NEAR(s.mean, 0.505, kTol);
+  const LatencySummary one = SummarizeLatency({0.3});
+  EXPECT_EQ(one.p50, 0.3);
+  EXPECT_EQ(one.p99, 0.3);
+  EXPECT_EQ(SummarizeLatency({}).max, 0.0);
+}
+
+TEST(LoadEngine, ReadLoadCloudsFindsPlyAndPcdRecursivelySorted) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tubepick_load_clouds_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "scene-2");
+  std::filesystem::create_directories(dir / "scene-1");
+  WritePly((dir / "scene-2" / "cloud.ply").string(), Points(5, Eigen::Vector3f(0.1f, 0.2f, 1.0f)));
+  WritePcd((dir / "scene-1" / "cloud.pcd").string(), Points(3, Eigen::Vector3f(0.1f, 0.2f, 1.0f)), true);
+  std::ofstream((dir / "notes.txt").string()) << "not a cloud\n";
+
+  const std::vector<LoadCloud> clouds = ReadLoadClouds(dir.string(), v1::LENGTH_UNIT_MILLIMETRE);
+  ASSERT_EQ(clouds.size(), 2u);
+  EXPECT_NE(clouds[0].name.find("scene-1"), std::string::npos);
+  EXPECT_EQ(clouds[0].xyz.size(), 3u * 12u);
+  EXPECT_EQ(clouds[1].xyz.size(), 5u * 12u);
+  EXPECT_EQ(clouds[1].unit, v1::LENGTH_UNIT_MILLIMETRE);
+  std::filesystem::remove_all(dir);
+
+  std::filesystem::create_directories(dir);
+  try {
+    ReadLoadClouds(dir.string(), v1::LENGTH_UNIT_UNSPECIFIED);
+    FAIL() << "an empty directory must throw";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("no .ply or .pcd"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LoadMetrics, PrometheusSampleMatchesNameAndLabels) {
+  const std::string text =
+      "# HELP process_resident_memory_bytes Resident memory.\n"
+      "# TYPE process_resident_memory_bytes gauge\n"
+      "process_resident_memory_bytes_total_bogus 1\n"
+      "process_resident_memory_bytes 123456789\n"
+      "tubepick_rpc_calls_total{method=\"PlanPick\",code=\"OK\"} 4\n"
+      "tubepick_rpc_calls_total{method=\"ModelTubes\",code=\"OK\"} 7\n";
+  EXPECT_EQ(PrometheusSample(text, "process_resident_memory_bytes"), 123456789.0);
+  EXPECT_EQ(PrometheusSample(text, "tubepick_rpc_calls_total", "method=\"ModelTubes\""), 7.0);
+  EXPECT_EQ(PrometheusSample(text, "tubepick_rpc_calls_total"), 4.0);
+  EXPECT_FALSE(PrometheusSample(text, "process_virtual_memory_bytes").has_value());
+}
+
+TEST(LoadMetrics, SummarizeRssComparesFirstAndLastMinute) {
+  // 10 minutes, one sample every 30 s: 100 MB in the first minute, 104 MB peak mid-run, 105 MB
+  // in the last minute.
+  std::vector<RssSample> samples;
+  for (int i = 0; i <= 20; ++i) {
+    std::uint64_t mb = i <= 2 ? 100 : (i >= 18 ? 105 : 104);
+    if (i == 10) mb = 120;
+    samples.push_back({30.0 * i, mb * 1'000'000});
+  }
+  const RssSummary s = SummarizeRss(samples, 60.0);
+  EXPECT_EQ(s.first_window_max, 100'000'000u);
+  EXPECT_EQ(s.last_window_max, 105'000'000u);
+  EXPECT_EQ(s.peak, 120'000'000u);
+  EXPECT_NEAR(s.growth_percent, 5.0, 1e-9);
+}
+
+TEST(LoadMetrics, HttpGetOfAClosedPortThrows) {
+  EXPECT_THROW(HttpGet("http://127.0.0.1:1/metrics", std::chrono::seconds(2)), std::runtime_error);
+  EXPECT_THROW(HttpGet("https://127.0.0.1:1/metrics", std::chrono::seconds(2)), std::runtime_error);
+}
+
+TEST(LoadAgainstServer, CountsOkAndInvalidArgumentRoundRobin) {
+  LocalServer server(/*workers=*/2, /*queue=*/8);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpc = LoadRpc::kModelTubes;
+  o.concurrency = 2;
+  o.total = 6;
+  o.warmup = 2;
+  o.metrics_url = server.metrics_url();
+  o.metrics_interval_seconds = 0.2;
+  const LoadReport r = RunLoad(o, {GoodCloud(), BadCloud()});
+
+  EXPECT_EQ(r.rpc, "model");
+  EXPECT_EQ(r.method, "tubepick.v1.PickPlannerService/ModelTubes");
+  EXPECT_EQ(r.total, 6u);
+  // Round robin over two clouds: 3 good, 3 bad calls, whatever the interleaving.
+  EXPECT_EQ(r.ok, 3u);
+  EXPECT_EQ(r.status_counts.at("OK"), 3u);
+  EXPECT_EQ(r.status_counts.at("INVALID_ARGUMENT"), 3u);
+  EXPECT_EQ(r.status_counts.size(), 2u);
+  EXPECT_NE(r.error_examples.at("INVALID_ARGUMENT").find("cloud.xyz"), std::string::npos)
+      << r.error_examples.at("INVALID_ARGUMENT");
+  ExpectOrdered(r.latency);
+  EXPECT_GT(r.elapsed_seconds, 0.0);
+  EXPECT_NEAR(r.requests_per_second, 6.0 / r.elapsed_seconds, 1e-9);
+  EXPECT_NEAR(r.ok_per_second, 3.0 / r.elapsed_seconds, 1e-9);
+
+  ASSERT_TRUE(r.rss.has_value());
+  ASSERT_FALSE(r.rss->samples.empty());
+  EXPECT_EQ(r.rss->failed_scrapes, 0u);
+  EXPECT_GT(r.rss->peak, 10'000'000u);  // a planning server is more than 10 MB resident
+  EXPECT_GE(r.rss->peak, r.rss->first_window_max);
+
+  const std::string text = FormatLoadReportText(r);
+  EXPECT_NE(text.find("[INVALID_ARGUMENT] 3 responses"), std::string::npos) << text;
+  EXPECT_NE(text.find("Server RSS"), std::string::npos) << text;
+  const std::string json = FormatLoadReportJson(r);
+  EXPECT_NE(json.find("\"INVALID_ARGUMENT\": 3"), std::string::npos) << json;
+}
+
+TEST(LoadAgainstServer, PlanPickStreamInSmallChunks) {
+  LocalServer server(/*workers=*/1, /*queue=*/4);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpc = LoadRpc::kPlanPickStream;
+  o.disable_simulation = true;
+  o.chunk_bytes = 64 * 1024;  // ~1.4 MB cloud → 22 chunks
+  o.concurrency = 1;
+  o.total = 2;
+  const LoadReport r = RunLoad(o, {GoodCloud()});
+  EXPECT_EQ(r.total, 2u);
+  EXPECT_EQ(r.ok, 2u) << FormatLoadReportText(r);
+  ExpectOrdered(r.latency);
+}
+
+TEST(LoadAgainstServer, ExpiredDeadlinesAreCountedByCode) {
+  LocalServer server(/*workers=*/1, /*queue=*/4);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpc = LoadRpc::kPlanPick;
+  o.concurrency = 1;
+  o.total = 2;
+  o.deadline_seconds = 0.001;  // far below one plan of 2.3 M points
+  const LoadReport r = RunLoad(o, {{"full", PackCloudXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
+  EXPECT_EQ(r.total, 2u);
+  EXPECT_EQ(r.ok, 0u);
+  EXPECT_EQ(r.status_counts.at("DEADLINE_EXCEEDED"), 2u);
+  EXPECT_EQ(r.latency.max, 0.0);  // no successful call, no latency
+}
+
+TEST(LoadAgainstServer, FullQueueIsCountedAsResourceExhausted) {
+  // One worker and one queue slot: of four calls arriving at once, at most two are admitted.
+  LocalServer server(/*workers=*/1, /*queue=*/1);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpc = LoadRpc::kModelTubes;
+  o.concurrency = 4;
+  o.total = 8;
+  const LoadReport r = RunLoad(o, {{"full", PackCloudXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
+  EXPECT_EQ(r.total, 8u);
+  EXPECT_GE(r.ok, 1u);
+  ASSERT_TRUE(r.status_counts.contains("RESOURCE_EXHAUSTED")) << FormatLoadReportText(r);
+  EXPECT_EQ(r.ok + r.status_counts.at("RESOURCE_EXHAUSTED"), 8u) << FormatLoadReportText(r);
+}
+
+TEST(LoadAgainstServer, UnreachableTargetThrows) {
+  LoadOptions o;
+  o.channel.target = "127.0.0.1:1";
+  o.total = 1;
+  o.connect_timeout_seconds = 0.5;
+  EXPECT_THROW(RunLoad(o, {GoodCloud()}), InvalidArgument);
+  o.total = 0;
+  EXPECT_THROW(RunLoad(o, {GoodCloud()}), InvalidArgument);  // neither total nor duration
+}
+
+TEST(Health, ServingServerAndClosedPort) {
+  LocalServer server(/*workers=*/1, /*queue=*/1);
+  ChannelOptions channel;
+  channel.target = server.target();
+  const HealthAnswer whole = CheckHealth(channel, "", std::chrono::seconds(5));
+  EXPECT_EQ(whole.grpc_code, 0) << whole.grpc_message;
+  EXPECT_EQ(whole.status, ServingStatus::kServing);
+  const HealthAnswer service =
+      CheckHealth(channel, "tubepick.v1.PickPlannerService", std::chrono::seconds(5));
+  EXPECT_EQ(service.status, ServingStatus::kServing);
+  const HealthAnswer unknown = CheckHealth(channel, "no.such.Service", std::chrono::seconds(5));
+  EXPECT_EQ(unknown.grpc_code, static_cast<int>(grpc::StatusCode::NOT_FOUND));
+
+  channel.target = "127.0.0.1:1";
+  const HealthAnswer closed = CheckHealth(channel, "", std::chrono::seconds(2));
+  EXPECT_EQ(closed.grpc_code, static_cast<int>(grpc::StatusCode::UNAVAILABLE)) << closed.grpc_message;
+}
+
+}  // namespace
+}  // namespace tubepick::cli
