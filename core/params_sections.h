@@ -46,6 +46,16 @@ void DescribeFields(Visit& v, GraspFilterParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, ToolParams& p) {
+  v("check", p.check);
+  v("finger_size", p.finger_size);
+  v("finger_tip_depth", p.finger_tip_depth);
+  v("housing_size", p.housing_size);
+  v("housing_gap", p.housing_gap);
+  v("margin", p.margin);
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, CostParams& p) {
   v("height_weight", p.height_weight);
   v("centre_weight", p.centre_weight);
@@ -59,6 +69,7 @@ void DescribeFields(Visit& v, PlanningParams& p) {
   v.Section("trajectories", p.trajectories);
   v.Section("grasps", p.grasps);
   v.Section("filters", p.filters);
+  v.Section("tool", p.tool);
   v.Section("cost", p.cost);
   v("empty_max_points", p.empty_max_points);
   v("empty_min_height", p.empty_min_height);

@@ -11,6 +11,7 @@
 #include "clients/cell/planner_client.h"
 #include "clients/cell/sim_round.h"
 #include "devices/sim/sim_cell.h"
+#include "physics/tube_geometry.h"
 #include "server/planner_server.h"
 #include "server/server_config.h"
 
@@ -75,6 +76,62 @@ TEST_F(CellEndToEndTest, ThreePvcTubesAreAllPickedAndPlaced) {
   const json& end = sink.records().back();
   EXPECT_EQ(end["type"], "end");
   EXPECT_EQ(end["truth"]["tubes_in_bin"], 0);
+}
+
+/// A straight tube on the floor along x (five nodes), bin frame.
+physics::TubeGeometry StraightTubeAlongX(int id, double radius, double length, double y) {
+  physics::TubeGeometry tube;
+  tube.id = id;
+  for (int i = 0; i < 5; ++i)
+    tube.nodes.push_back({i + 1, Eigen::Vector3d((i / 4.0 - 0.5) * length, y, radius), radius});
+  for (int i = 0; i < 4; ++i) {
+    physics::TubeEdge e;
+    e.node1 = i + 1;
+    e.node2 = i + 2;
+    e.order = i + 1;
+    e.radius = radius;
+    physics::SetEdgeFromNodes(tube, e);
+    tube.edges.push_back(e);
+  }
+  return tube;
+}
+
+TEST_F(CellEndToEndTest, TubeAlongALongWallIsNudgedOffItAndPicked) {
+  // The last tube of a failed 20-round run: PVC, its axis 23.5 mm from the −y wall (11 mm between
+  // tube and wall). Every grasp across it drives a pad or the housing into the wall, so the planner
+  // rejects them all; the controller drags it off the wall, rescans and picks it.
+  devices::sim::SimCellParams sim_params =
+      devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 1, 5);
+  const double r = sim_params.cell.tube.radius;
+  devices::sim::SimCell sim(sim_params, {StraightTubeAlongX(1, r, 0.5, -0.3 + 0.0235)});
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+  cell::CellControllerParams params;
+  params.seed = 11;
+
+  const cell::SimRoundResult result = cell::RunSimRound(planner, sim, params, 0, &sink);
+
+  EXPECT_EQ(result.run.reason, cell::CellStopReason::kBinEmpty) << result.run.message;
+  EXPECT_EQ(result.tubes_in_bin, 0u);
+  EXPECT_EQ(result.run.picks, 1u);
+  EXPECT_GE(result.run.nudges, 1u);
+  EXPECT_LE(result.run.nudges, params.nudge.max_nudges_per_bin);
+  std::vector<json> nudges;
+  for (const json& rec : sink.records())
+    if (rec["type"] == "attempt" && rec["result"] == "nudge") nudges.push_back(rec);
+  ASSERT_EQ(nudges.size(), result.run.nudges);
+  const json& first = nudges.front();
+  EXPECT_EQ(first["plans"], 0);  // the planner filtered every grasp of the wall tube
+  EXPECT_EQ(first["tubes_left_plan"], 1);
+  EXPECT_NEAR(first["nudge"]["direction"][1].get<double>(), 1.0, 1e-9);  // straight off the −y wall
+  EXPECT_LT(first["nudge"]["wall_distance"].get<double>(), 0.04);
+  EXPECT_EQ(first["truth_after"]["tubes_in_bin"], 1);  // nudged, not thrown out
+
+  const cell::CellStatistics stats = cell::SummarizeRecords(sink.records());
+  EXPECT_EQ(stats.bins_emptied, 1u);
+  EXPECT_EQ(stats.nudges.uses, result.run.nudges);
+  EXPECT_EQ(stats.nudges.successes, 1u);
+  EXPECT_EQ(stats.attempts, 1u);  // nudges are not picking attempts
 }
 
 TEST_F(CellEndToEndTest, ServerGoneMidRoundEndsInSafeStopWithTheGripperOpen) {

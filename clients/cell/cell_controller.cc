@@ -56,6 +56,8 @@ std::string ToString(CellState state) {
       return "resolve";
     case CellState::kReturnToBin:
       return "return_to_bin";
+    case CellState::kNudge:
+      return "nudge";
     case CellState::kRelease:
       return "release";
     case CellState::kHome:
@@ -411,6 +413,24 @@ void CellController::Place(const Eigen::Isometry3d& X_place, Attempt& attempt) {
   TransitTo(HomePose(params_, cell_), &attempt);
 }
 
+void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {
+  Enter(CellState::kNudge);
+  // Closed pads (nothing between them: the gripper is at home) make one narrow block.
+  CheckGripper(CallDevice("gripper", state_, [&] {
+    return devices_.gripper->Close(params_.gripper_speed, params_.gripper_force, params_.gripper_timeout);
+  }));
+  Eigen::Isometry3d X_above = plan.X_BinTcp_press;
+  X_above.translation().z() += params_.approach_height;
+  TransitTo(X_above, &attempt);
+  MoveTo(plan.X_BinTcp_press, params_.approach_speed, &attempt);
+  MoveThrough(NudgePushWaypoints(plan), params_.nudge.speed, &attempt);
+  MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, params_.approach_height)},
+              params_.approach_speed, &attempt);
+  OpenGripper();
+  Enter(CellState::kHome);
+  TransitTo(HomePose(params_, cell_), &attempt);
+}
+
 void CellController::ReturnToBin(const Eigen::Isometry3d& X_grasp, const Eigen::Isometry3d& X_lift,
                                  Attempt& attempt) {
   Enter(CellState::kReturnToBin);
@@ -475,6 +495,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
   CellRunResult result;
   std::uint32_t attempts_since_pick = 0;
   std::uint32_t consecutive_failures = 0;
+  std::uint32_t nudges_since_pick = 0;
   std::optional<Attempt> active;
   const nlohmann::json truth_start = Truth();
 
@@ -592,26 +613,60 @@ CellRunResult CellController::Run(std::uint32_t round) {
             ++result.picks;
             attempts_since_pick = 0;
             consecutive_failures = 0;
+            nudges_since_pick = 0;
             break;
           }
           ++consecutive_failures;
           if (outcome != AttemptResult::kGraspFailed) break;  // the bin changed: rescan
         }
         if (executed == 0) {
-          // No plan, or none the tool can execute: rescan (with the next seed).
+          // No plan, or none the tool can execute: nudge a tube off a wall, if one lies along it,
+          // then rescan (with the next seed).
           ++consecutive_failures;
+          std::optional<NudgePlan> nudge;
+          if (params_.nudge.enabled && params_.check_tool_clearance &&
+              result.nudges < params_.nudge.max_nudges_per_bin && response.tubes_size() > 0)
+            nudge = PlanNudge(response.tubes(), cell_, params_.tool, params_.nudge, params_.approach_height,
+                              nudges_since_pick);
           nlohmann::json rec = base_record(0);
           rec["attempt"] = nullptr;
           rec["result"] = "no_plan";
           rec["skipped_plans"] = std::move(skipped);
           rec["durations"] = {{"planning_wall_s", planning_wall_s},
-                              {"planning_server_s", response.total_seconds()},
-                              {"attempt_wall_s", SecondsSince(scan_start)},
-                              {"attempt_device_s", DeviceNow() - scan_device_start}};
+                              {"planning_server_s", response.total_seconds()}};
+          if (nudge) {
+            ++result.nudges;
+            ++nudges_since_pick;
+            rec["nudge"] = {{"tube", nudge->tube_id},
+                            {"contact", Vec(nudge->p_Bin_contact)},
+                            {"wall_distance", nudge->wall_distance},
+                            {"direction", Vec(nudge->direction)},
+                            {"shift", nudge->shift},
+                            {"distance", nudge->distance},
+                            {"tcp_pose", PoseJson(nudge->X_BinTcp_press)}};
+            active.emplace();
+            active->record = std::move(rec);
+            active->started = scan_start;
+            active->device_started = scan_device_start;
+            spdlog::info(
+                "cell: round {} scan {}: no executable plan; nudging tube {} ({:.3f} m from a wall) "
+                "{:.3f} m along ({:.2f}, {:.2f})",
+                round, scan, nudge->tube_id, nudge->wall_distance, nudge->distance, nudge->direction.x(),
+                nudge->direction.y());
+            ExecuteNudge(*nudge, *active);
+            rec = std::move(active->record);
+            rec["result"] = "nudge";
+            rec["durations"]["robot_wall_s"] = active->robot_wall_s;
+            rec["durations"]["robot_device_s"] = active->robot_device_s;
+            active.reset();
+          }
+          rec["durations"]["attempt_wall_s"] = SecondsSince(scan_start);
+          rec["durations"]["attempt_device_s"] = DeviceNow() - scan_device_start;
           rec["truth_after"] = Truth();
           if (sink_) sink_->Write(rec);
-          spdlog::info("cell: round {} scan {}: no executable plan ({} plans, {} skipped)", round, scan,
-                       response.plans_size(), rec["skipped_plans"].size());
+          if (!nudge)
+            spdlog::info("cell: round {} scan {}: no executable plan ({} plans, {} skipped)", round, scan,
+                         response.plans_size(), rec["skipped_plans"].size());
         }
       }
     } catch (const CellFault&) {
@@ -643,6 +698,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
                   {"picks", result.picks},
                   {"attempts", result.attempts},
                   {"scans", result.scans},
+                  {"nudges", result.nudges},
                   {"truth_start", truth_start},
                   {"truth", Truth()}});
   return result;

@@ -34,6 +34,7 @@ enum class CellState {
   kPlace,        ///< transit to the place pose, open
   kResolve,      ///< resolution rotations, each followed by a new reading and analysis
   kReturnToBin,  ///< lower the tubes back into the bin and open
+  kNudge,        ///< no executable plan: drag a tube lying along a wall towards the middle
   kRelease,      ///< open after nothing was grasped / lifted
   kHome,         ///< back to the home pose
   kSafeStop,     ///< open the gripper and move up, if possible
@@ -67,6 +68,8 @@ struct CellRunResult {
   /// Picking attempts (grasp executions).
   std::uint32_t attempts = 0;
   std::uint32_t scans = 0;
+  /// Nudges (NudgeParams) performed.
+  std::uint32_t nudges = 0;
   /// Set when reason == kFault.
   std::optional<CellFault> fault;
   /// Safe stop: whether the gripper could be opened and the robot moved up.
@@ -92,7 +95,10 @@ struct CellRunResult {
 ///
 /// Plans the tool cannot execute without touching the bin (ToolClearanceProblem) are skipped and
 /// listed in the next record's skipped_plans; a scan without an executable plan is a "no_plan"
-/// record and a rescan.
+/// record and a rescan — or, when the planner modeled a tube lying along a wall (PlanNudge) and the
+/// nudge limit allows, a "nudge": close the gripper, press on the tube's top, drag it away from the
+/// wall, open at the top, go home and rescan. A scan that ends in a nudge counts as a consecutive
+/// failure (not as a picking attempt); max_nudges_per_bin bounds them per run.
 ///
 /// Every picking attempt (and every scan without a plan) is one record ("type": "attempt"):
 ///   round, attempt, scan, plan_rank, seed, tubes_left_plan (tubes the planner modeled),
@@ -100,11 +106,12 @@ struct CellRunResult {
 ///   opening_width}, gripper (status after closing), wrench {reference, lift, after_resolution[]},
 ///   analysis {outcome, tube_ratio, held_weight, estimated_count, motions}, resolution {available,
 ///   used, succeeded}, result ("picked", "multiple_returned", "none", "grasp_failed", "no_plan",
-///   "fault"), fault {device, kind, state, error}, durations {planning_wall_s, planning_server_s,
+///   "nudge", "fault"), nudge {tube, contact, wall_distance, direction, shift, distance, tcp_pose}
+///   (result "nudge"), fault {device, kind, state, error}, durations {planning_wall_s, planning_server_s,
 ///   analysis_wall_s, robot_wall_s, robot_device_s, attempt_wall_s, attempt_device_s},
 ///   truth_before / truth_after (the annotator's object, when set).
 /// A safe stop writes {"type": "safe_stop", ...}; every run ends with {"type": "end", reason,
-/// message, picks, attempts, scans, truth}.
+/// message, picks, attempts, scans, nudges, truth}.
 class CellController {
  public:
   /// @throws InvalidArgument when a device pointer is null or params/cell are invalid.
@@ -133,6 +140,8 @@ class CellController {
   std::optional<std::string> ClearanceProblem(const v1::PickPlan& plan, int rank) const;
   void ExecutePlan(const v1::PlanPickResponse& response, int plan_index, Attempt& attempt);
   void Place(const Eigen::Isometry3d& X_place, Attempt& attempt);
+  /// The nudge skill's motions (kNudge), from home back to home.
+  void ExecuteNudge(const NudgePlan& plan, Attempt& attempt);
   void ReturnToBin(const Eigen::Isometry3d& X_grasp, const Eigen::Isometry3d& X_lift, Attempt& attempt);
   void OpenGripper();
   v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,

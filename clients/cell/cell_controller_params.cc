@@ -48,6 +48,17 @@ void CellControllerParams::Validate() const {
       !std::isfinite(tool.finger_tip_depth) || !std::isfinite(tool.housing_gap) ||
       !std::isfinite(tool.margin))
     throw InvalidArgument("cell controller tool: sizes must be finite, finger sizes positive");
+  RequireNonNegativeValue(nudge.near_wall_distance, "nudge.near_wall_distance");
+  RequireNonNegativeValue(nudge.target_wall_distance, "nudge.target_wall_distance");
+  RequireNonNegativeValue(nudge.push_gain, "nudge.push_gain");
+  RequireNonNegativeValue(nudge.min_push, "nudge.min_push");
+  RequirePositiveValue(nudge.max_push, "nudge.max_push");
+  if (nudge.min_push > nudge.max_push)
+    throw InvalidArgument(fmt::format("cell controller nudge.min_push: {} exceeds nudge.max_push {}",
+                                      nudge.min_push, nudge.max_push));
+  RequireNonNegativeValue(nudge.press_depth, "nudge.press_depth");
+  RequirePositiveValue(nudge.speed, "nudge.speed");
+  RequirePositiveValue(nudge.sample_spacing, "nudge.sample_spacing");
   RequirePositiveValue(gripper_speed, "gripper_speed");
   RequirePositiveValue(gripper_force, "gripper_force");
   RequirePositiveCount(ft_samples, "ft_samples");

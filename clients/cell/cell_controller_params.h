@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "clients/cell/nudge.h"
 #include "clients/cell/tool_clearance.h"
 #include "core/common/cell_config.h"
 #include "devices/device_error.h"
@@ -45,6 +46,9 @@ struct CellControllerParams {
   /// before execution: a protective stop would end the round.
   bool check_tool_clearance = true;
   ToolGeometry tool;
+  /// The nudge skill for a scan whose tubes have no executable plan (see NudgeParams); it needs
+  /// check_tool_clearance (its moves are checked with `tool`).
+  NudgeParams nudge;
 
   // --- gripper ---
   /// Closing speed (m/s) and force (N) (Robotiq 2F-85: 0.02-0.15 m/s, 20-235 N).

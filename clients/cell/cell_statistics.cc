@@ -18,6 +18,8 @@ struct RoundState {
   std::set<std::uint32_t> counts_attempted;
   std::set<std::uint32_t> first_try_success;  // counts whose first attempt picked
   double planning = 0.0, motion = 0.0, cycle = 0.0;
+  /// A nudge not yet followed by a pick.
+  bool nudge_pending = false;
 };
 
 bool HasTruth(const json& truth) { return truth.is_object() && truth.contains("tubes_in_bin"); }
@@ -89,6 +91,12 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
       state.cycle += Duration(r, "attempt_wall_s");
       if (result == "no_plan") {
         ++s.no_plan_scans;
+        state.nudge_pending = false;
+        continue;
+      }
+      if (result == "nudge" || r.contains("nudge")) {
+        ++s.nudges.uses;
+        state.nudge_pending = result == "nudge";
         continue;
       }
       const std::uint32_t n = TubesInBin(r);
@@ -117,6 +125,8 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
         if (r["resolution"].value("succeeded", false)) ++s.resolution.successes;
       }
       if (picked) {
+        if (state.nudge_pending) ++s.nudges.successes;
+        state.nudge_pending = false;
         ++s.picks;
         ++c.picked;
         if (first_at_count) ++c.first_try;
@@ -176,6 +186,7 @@ json StatisticsJson(const CellStatistics& s) {
           {"upward", use(s.upward)},
           {"escape", use(s.escape)},
           {"resolution", use(s.resolution)},
+          {"nudges", use(s.nudges)},
           {"time_per_pick",
            {{"planning", times(s.times.planning)},
             {"motion", times(s.times.motion)},

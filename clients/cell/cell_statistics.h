@@ -61,7 +61,7 @@ struct CellStatistics {
   /// Tubes that left the bin during attempts that did not place exactly one of them: carried along
   /// with the picked one, or dropped outside (ground truth).
   std::uint32_t tubes_lost = 0;
-  /// Picking attempts (grasp executions) and scans that gave no plan.
+  /// Picking attempts (grasp executions) and scans that gave no plan (without a nudge).
   std::uint32_t attempts = 0;
   std::uint32_t no_plan_scans = 0;
   std::uint32_t grasp_failures = 0;
@@ -75,6 +75,9 @@ struct CellStatistics {
   UseCount upward, escape;
   /// Table 5.9: attempts that used the resolution rotation and those it turned into a pick.
   UseCount resolution;
+  /// Nudges (result "nudge", or a fault during one), and those followed by a pick in the same
+  /// round before the next nudge or scan without a plan.
+  UseCount nudges;
   PickTimes times;
 
   /// Overall first-try success: sum of first_try over sum of picked.

@@ -8,6 +8,14 @@ SimRoundResult RunSimRound(PlannerClient& planner, const devices::sim::SimCellPa
                            const CellControllerParams& params, std::uint32_t round, RecordSink* sink) {
   const auto wall_start = std::chrono::steady_clock::now();
   devices::sim::SimCell sim(sim_params);
+  SimRoundResult result = RunSimRound(planner, sim, params, round, sink);
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+SimRoundResult RunSimRound(PlannerClient& planner, devices::sim::SimCell& sim,
+                           const CellControllerParams& params, std::uint32_t round, RecordSink* sink) {
+  const auto wall_start = std::chrono::steady_clock::now();
   CellController controller({&sim.scanner(), &sim.robot(), &sim.gripper(), &sim.ft_sensor()}, planner,
                             sim.cell(), params, sink);
   controller.set_device_clock([&sim] { return sim.SimulatedSeconds(); });

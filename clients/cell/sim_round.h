@@ -28,4 +28,9 @@ struct SimRoundResult {
 SimRoundResult RunSimRound(PlannerClient& planner, const devices::sim::SimCellParams& sim_params,
                            const CellControllerParams& params, std::uint32_t round, RecordSink* sink);
 
+/// The same on a cell built by the caller (e.g. with explicit tubes: SimCell(params, tubes_Bin));
+/// wall_s then covers only the run.
+SimRoundResult RunSimRound(PlannerClient& planner, devices::sim::SimCell& sim,
+                           const CellControllerParams& params, std::uint32_t round, RecordSink* sink);
+
 }  // namespace tubepick::cell

@@ -106,6 +106,11 @@ std::string FormatCellTables(const CellStatistics& s, const std::string& title) 
   out += use_line("success rate", s.resolution);
   out += "\n";
 
+  out += "Nudges: a tube along a wall dragged off it when no plan was executable (beyond the thesis)\n";
+  out += fmt::format("  {:<34}{:>7}\n", "nudges", s.nudges.uses);
+  out += use_line("followed by a pick", s.nudges);
+  out += "\n";
+
   out += "Time per pick (everything since the previous pick)\n";
   out += fmt::format("  {:<34}{:>9}{:>9}\n", "", "median", "mean");
   const auto time_line = [](const std::string& label, const std::vector<double>& v) {

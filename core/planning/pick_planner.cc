@@ -104,6 +104,15 @@ void PlanningParams::Validate() const {
     }
   }
 
+  const ToolParams& tool_params = tool;
+  for (int k = 0; k < 3; ++k) {
+    RequirePositive(tool_params.finger_size[k], "planning.tool.finger_size[" + std::to_string(k) + "]");
+    RequireNonNegative(tool_params.housing_size[k], "planning.tool.housing_size[" + std::to_string(k) + "]");
+  }
+  RequireFinite(tool_params.finger_tip_depth, "planning.tool.finger_tip_depth");
+  RequireNonNegative(tool_params.housing_gap, "planning.tool.housing_gap");
+  RequireNonNegative(tool_params.margin, "planning.tool.margin");
+
   RequireNonNegative(cost.height_weight, "planning.cost.height_weight");
   RequireNonNegative(cost.centre_weight, "planning.cost.centre_weight");
   RequireNonNegative(cost.trajectory_weight, "planning.cost.trajectory_weight");
@@ -219,6 +228,11 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
         }
         if (!InsideWorkspace(grasp, trajectory, params.filters)) {
           ++counts.rejected_workspace;
+          continue;
+        }
+        if (params.tool.check &&
+            !ToolClears(cell.bin, params.tool, grasp.X_BinTcp, grasp.opening_width, trajectory.waypoints)) {
+          ++counts.rejected_tool;
           continue;
         }
         if (tg.collides[gi] < 0) tg.collides[gi] = FingersCollide(grasp, *raw, params.filters) ? 1 : 0;

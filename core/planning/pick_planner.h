@@ -11,6 +11,7 @@
 #include "core/planning/grasp_filters.h"
 #include "core/planning/grasp_ranking.h"
 #include "core/planning/grasp_synthesis.h"
+#include "core/planning/tool_clearance.h"
 #include "core/planning/trajectory.h"
 #include "core/planning/trajectory_synthesis.h"
 
@@ -23,6 +24,10 @@ struct PlanningParams {
   TrajectoryParams trajectories;
   GraspParams grasps;
   GraspFilterParams filters;
+  /// The gripper's pads and housing for the tool-clearance filter (ToolClears): a grasp whose
+  /// tool would touch a bin wall or the floor at the grasp pose or at a trajectory waypoint is
+  /// not executable and is rejected, so the stages fall through to other tubes. Beyond the thesis.
+  ToolParams tool;
   CostParams cost;
   /// Bin-empty test: the bin is empty when no tube was modeled and at most this many filtered
   /// points lie higher than empty_min_height.
@@ -52,10 +57,11 @@ struct PlanningCounts {
   std::uint32_t trajectories = 0;
   std::uint32_t simulated_trajectories = 0;
   /// (grasp, trajectory) pairs tested, and how many each filter rejected (the first failing one,
-  /// tested in the order section, workspace, fingers).
+  /// tested in the order section, workspace, tool clearance, fingers).
   std::uint64_t grasp_candidates = 0;
   std::uint64_t rejected_section = 0;
   std::uint64_t rejected_workspace = 0;
+  std::uint64_t rejected_tool = 0;
   std::uint64_t rejected_fingers = 0;
   std::uint32_t plans = 0;
 };
@@ -90,11 +96,12 @@ bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params);
 ///    non-occluded tubes (upward trajectory, T_cost 0, no simulation); then weakly occluded
 ///    tubes (upward + two escapes); then, if strongly_occluded_candidates, strongly occluded
 ///    ones (upward + one occlusion escape per occluded joint);
-/// 3. per trajectory, the tube's grasps are filtered (section, workspace, finger boxes on the raw
-///    cloud, binned once per call); in stages 2 and 3 the trajectories that keep at least one
-///    viable grasp (only those: a trajectory without a grasp cannot be executed) are sent to
-///    `evaluator` in one Evaluate call, with all modeled tubes (Trajectory::tube_index = position
-///    in modeling.tubes) — when `evaluator` is null nothing is simulated and T_cost is 0;
+/// 3. per trajectory, the tube's grasps are filtered (section, workspace, tool clearance against
+///    the bin's walls and floor at the grasp and every waypoint when params.tool.check, finger
+///    boxes on the raw cloud, binned once per call); in stages 2 and 3 the trajectories that keep at least
+///    one viable grasp (only those: a trajectory without a grasp cannot be executed) are sent to `evaluator`
+///    in one Evaluate call, with all modeled tubes (Trajectory::tube_index = position in modeling.tubes) —
+///    when `evaluator` is null nothing is simulated and T_cost is 0;
 /// 4. every viable (grasp, trajectory) becomes a plan with its cost (Eq. 5.3); plans best first.
 /// max_z of Eq. 5.4 is modeling.max_height, or, when that is ≤ 0 (a hand-built model), the
 /// highest cylinder endpoint plus its radius. Deterministic for a deterministic evaluator.

@@ -333,6 +333,104 @@ TEST_F(CellControllerTest, ScansWithoutPlanCountAsConsecutiveFailures) {
   EXPECT_TRUE(records[0]["attempt"].is_null());
 }
 
+/// A PlanPick answer without plans whose one modeled tube lies along the −y wall (axis 3 cm from it).
+testing::ScriptedPlanner::PlanAnswer WallTubeWithoutPlan() {
+  testing::ScriptedPlanner::PlanAnswer a = Plans({}, 0);
+  v1::Tube* tube = a.response.add_tubes();
+  tube->set_id(0);
+  tube->set_occlusion(v1::OCCLUSION_NONE);
+  v1::Cylinder* c = tube->add_cylinders();
+  *c->mutable_start() = ToWire(Eigen::Vector3d(-0.2, -0.27, 0.0125));
+  *c->mutable_end() = ToWire(Eigen::Vector3d(0.2, -0.27, 0.0125));
+  c->set_radius(0.0125);
+  return a;
+}
+
+TEST_F(CellControllerTest, TubeAlongAWallWithoutExecutablePlanIsNudgedThenPicked) {
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  planner.plan_answers.push_back(Plans({MakePlan(0, p_grasp)}, 1));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.nudges, 1u);
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.attempts, 1u);  // the nudge is not a picking attempt
+  EXPECT_EQ(result.scans, 3u);
+  EXPECT_EQ(gripper.closes, 2);  // closed for the nudge, then on the tube
+
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 2u);
+  const json& nudge = records[0];
+  EXPECT_EQ(nudge["result"], "nudge");
+  EXPECT_TRUE(nudge["attempt"].is_null());
+  EXPECT_EQ(nudge["nudge"]["tube"], 0);
+  EXPECT_NEAR(nudge["nudge"]["direction"][1].get<double>(), 1.0, kTol);
+  EXPECT_NEAR(nudge["nudge"]["wall_distance"].get<double>(), 0.03, 1e-9);
+  const double distance = nudge["nudge"]["distance"].get<double>();
+  EXPECT_NEAR(distance, params.nudge.max_push, kTol);  // 2 · (0.15 − 0.03) = 0.24 → 0.22
+  EXPECT_GT(nudge["durations"]["robot_wall_s"].get<double>(), 0.0);
+  EXPECT_EQ(records[1]["result"], "picked");
+
+  // The robot pressed at the planned pose and pushed along +y by the planned distance.
+  bool pushed = false;
+  for (const testing::ScriptedRobot::Move& m : robot.moves) {
+    if (m.through && m.waypoints.size() == 2 &&
+        m.waypoints.back().isApprox(Eigen::Vector3d(0.0, distance, 0.0), 1e-12)) {
+      pushed = true;
+      EXPECT_DOUBLE_EQ(m.speed, params.nudge.speed);
+    }
+  }
+  EXPECT_TRUE(pushed);
+  EXPECT_EQ(Records("end").back()["nudges"], 1);
+}
+
+TEST_F(CellControllerTest, NudgesStopAtTheirLimitAndScansThenOnlyRescan) {
+  params.nudge.max_nudges_per_bin = 2;
+  for (int i = 0; i < 4; ++i) planner.plan_answers.push_back(WallTubeWithoutPlan());
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.nudges, 2u);
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 4u);
+  EXPECT_EQ(records[0]["result"], "nudge");
+  EXPECT_EQ(records[1]["result"], "nudge");
+  EXPECT_EQ(records[2]["result"], "no_plan");
+  EXPECT_EQ(records[3]["result"], "no_plan");
+  EXPECT_EQ(gripper.closes, 2);
+  // Every one of them counted as a consecutive failure.
+  params.max_consecutive_failures = 1;
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  const CellRunResult limited = Run();
+  EXPECT_EQ(limited.reason, CellStopReason::kLimitReached);
+  EXPECT_EQ(limited.nudges, 1u);
+}
+
+TEST_F(CellControllerTest, NudgeDisabledOrWithoutGeometryIsANoPlanScan) {
+  params.nudge.enabled = false;
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  EXPECT_EQ(Run().nudges, 0u);
+  EXPECT_EQ(Records("attempt").back()["result"], "no_plan");
+  EXPECT_EQ(gripper.closes, 0);
+}
+
+TEST_F(CellControllerTest, RobotFaultDuringANudgeEndsInSafeStopAndIsRecorded) {
+  robot.fail_through_from = 0;  // the push is the first MoveThrough
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kFault);
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "robot");
+  EXPECT_EQ(result.fault->state(), "nudge");
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["result"], "fault");
+  EXPECT_TRUE(records[0].contains("nudge"));
+  EXPECT_EQ(records[0]["fault"]["state"], "nudge");
+}
+
 TEST_F(CellControllerTest, PerBinLimitCountsAllAttempts) {
   params.max_attempts_per_bin = 2;
   for (int i = 0; i < 3; ++i) {

@@ -115,3 +115,30 @@ TEST(CellStatisticsTest, MedianOfEvenAndOddLists) {
 
 }  // namespace
 }  // namespace tubepick::cell
+
+namespace tubepick::cell {
+namespace {
+
+TEST(CellStatisticsTest, NudgesCountWhenAPickFollowsBeforeTheNextScanWithoutPlan) {
+  json nudge = Attempt(0, 1, 1, "nudge");
+  nudge["nudge"] = {{"tube", 0}};
+  json nudge1 = Attempt(1, 1, 1, "nudge");
+  nudge1["nudge"] = {{"tube", 0}};
+  json fault = Attempt(1, 1, 1, "fault");
+  fault["nudge"] = {{"tube", 0}};
+  const std::vector<json> records = {
+      // Round 0: nudge, nudge, picked (one success, one nudge superseded by the next), nudge at the end.
+      nudge, nudge, Attempt(0, 1, 0, "picked"), nudge, End(0, "limit_reached", 1, 0),
+      // Round 1: a nudge, a scan without a plan, then a pick: the nudge did not help; a nudge fault.
+      nudge1, Attempt(1, 1, 1, "no_plan"), Attempt(1, 1, 0, "picked"), fault, End(1, "fault", 1, 0)};
+  const CellStatistics s = SummarizeRecords(records);
+  EXPECT_EQ(s.nudges.uses, 5u);
+  EXPECT_EQ(s.nudges.successes, 1u);
+  EXPECT_EQ(s.attempts, 2u);  // nudges (and a fault during one) are not picking attempts
+  EXPECT_EQ(s.picks, 2u);
+  EXPECT_EQ(s.no_plan_scans, 1u);
+  EXPECT_EQ(StatisticsJson(s)["nudges"]["uses"], 5);
+}
+
+}  // namespace
+}  // namespace tubepick::cell

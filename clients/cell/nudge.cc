@@ -1,0 +1,152 @@
+#include "clients/cell/nudge.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "clients/cell/wire_convert.h"
+
+namespace tubepick::cell {
+namespace {
+
+struct Sample {
+  Eigen::Vector3d p;
+  double radius = 0.0;
+  double fraction = 0.0;  // along the tube's cylinders
+};
+
+/// Distance of xy point p to each wall (+x, −x, +y, −y) and that wall's inward normal.
+struct Walls {
+  std::array<double, 4> distance{};
+  static Eigen::Vector3d Inward(int w) {
+    switch (w) {
+      case 0:
+        return -Eigen::Vector3d::UnitX();
+      case 1:
+        return Eigen::Vector3d::UnitX();
+      case 2:
+        return -Eigen::Vector3d::UnitY();
+      default:
+        return Eigen::Vector3d::UnitY();
+    }
+  }
+};
+
+Walls WallDistances(const Eigen::Vector3d& p, const CellConfig& cell) {
+  const Eigen::Vector3d half = 0.5 * cell.bin.inner_size;
+  Walls w;
+  w.distance = {half.x() - p.x(), half.x() + p.x(), half.y() - p.y(), half.y() + p.y()};
+  return w;
+}
+
+std::vector<Sample> SampleTube(const v1::Tube& tube, double spacing, double default_radius) {
+  double total = 0.0;
+  for (const v1::Cylinder& c : tube.cylinders()) total += (FromWire(c.end()) - FromWire(c.start())).norm();
+  std::vector<Sample> samples;
+  if (!(total > 0.0)) return samples;
+  double offset = 0.0;
+  for (const v1::Cylinder& c : tube.cylinders()) {
+    const Eigen::Vector3d a = FromWire(c.start()), b = FromWire(c.end());
+    const double length = (b - a).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(length / spacing)));
+    const double radius = c.radius() > 0.0 ? c.radius() : default_radius;
+    for (int k = 0; k <= n; ++k) {
+      const double t = static_cast<double>(k) / n;
+      samples.push_back({a + t * (b - a), radius, (offset + t * length) / total});
+    }
+    offset += length;
+  }
+  return samples;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan) {
+  const Eigen::Vector3d push = plan.distance * plan.direction;
+  return {Eigen::Vector3d::Zero(), push};
+}
+
+std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
+                                   const CellConfig& cell, const ToolGeometry& tool,
+                                   const NudgeParams& params, double lift, std::uint32_t try_index) {
+  static constexpr std::array<double, 3> kFractions = {0.5, 0.3, 0.7};
+  const double fraction = kFractions[try_index % kFractions.size()];
+
+  // Tubes along a wall: non-occluded first, then closest to a wall.
+  struct Candidate {
+    int index;
+    bool occluded;
+    double wall_distance;
+  };
+  std::vector<Candidate> candidates;
+  for (int i = 0; i < tubes.size(); ++i) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Sample& s : SampleTube(tubes[i], params.sample_spacing, cell.tube.radius)) {
+      const Walls w = WallDistances(s.p, cell);
+      nearest = std::min(nearest, *std::min_element(w.distance.begin(), w.distance.end()));
+    }
+    if (nearest < params.near_wall_distance)
+      candidates.push_back(
+          {i, tubes[i].occlusion() == v1::OCCLUSION_WEAK || tubes[i].occlusion() == v1::OCCLUSION_STRONG,
+           nearest});
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    if (a.occluded != b.occluded) return !a.occluded;
+    return a.wall_distance < b.wall_distance;
+  });
+
+  for (const Candidate& candidate : candidates) {
+    const v1::Tube& tube = tubes[candidate.index];
+    std::vector<Sample> samples = SampleTube(tube, params.sample_spacing, cell.tube.radius);
+    // Contact points along a wall, closest to the wanted fraction first.
+    std::stable_sort(samples.begin(), samples.end(), [&](const Sample& a, const Sample& b) {
+      return std::abs(a.fraction - fraction) < std::abs(b.fraction - fraction);
+    });
+    for (const Sample& s : samples) {
+      const Walls w = WallDistances(s.p, cell);
+      Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 4; ++k) {
+        if (w.distance[k] < params.near_wall_distance) direction += Walls::Inward(k);
+        nearest = std::min(nearest, w.distance[k]);
+      }
+      if (direction.norm() < 1e-9) continue;
+      direction.normalize();
+
+      NudgePlan plan;
+      plan.tube_id = tube.id();
+      plan.p_Bin_contact = s.p;
+      plan.wall_distance = nearest;
+      plan.direction = direction;
+      plan.distance = std::clamp(params.push_gain * (params.target_wall_distance - nearest), params.min_push,
+                                 params.max_push);
+      // z_Tcp down, x_Tcp along the push: the housing's narrow side faces the wall.
+      Eigen::Matrix3d R;
+      R.col(0) = direction;
+      R.col(2) = -Eigen::Vector3d::UnitZ();
+      R.col(1) = R.col(2).cross(R.col(0));
+      R = R * Eigen::AngleAxisd(-params.tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const double pad_bottom = s.p.z() + s.radius - params.press_depth;
+      // The pads (tool.finger_size.x along the push) must still cover the tube's top.
+      const double max_shift = 0.5 * tool.finger_size.x() + 0.5 * s.radius;
+      const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
+                                                 plan.distance * direction + Eigen::Vector3d(0, 0, lift)};
+      for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
+        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+        X.linear() = R;
+        // The pads' bottom centre (tool.finger_tip_depth along z_Tcp) on the contact point.
+        Eigen::Vector3d tip = s.p + shift * direction;
+        tip.z() = pad_bottom;
+        X.translation() = tip - tool.finger_tip_depth * R.col(2);
+        if (ToolClearanceProblem(cell, tool, X, 0.0, path)) continue;
+        plan.shift = shift;
+        plan.X_BinTcp_press = X;
+        return plan;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace tubepick::cell

@@ -1,0 +1,99 @@
+#include "clients/cell/nudge.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "clients/cell/wire_convert.h"
+
+namespace tubepick::cell {
+namespace {
+
+constexpr double kR = 0.0125;
+
+v1::Tube StraightTube(std::uint32_t id, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      v1::Occlusion occlusion = v1::OCCLUSION_NONE) {
+  v1::Tube tube;
+  tube.set_id(id);
+  tube.set_occlusion(occlusion);
+  v1::Cylinder* c = tube.add_cylinders();
+  *c->mutable_start() = ToWire(a);
+  *c->mutable_end() = ToWire(b);
+  c->set_radius(kR);
+  return tube;
+}
+
+class NudgeTest : public ::testing::Test {
+ protected:
+  CellConfig cell;  // bin 0.8 × 0.6 × 0.2 m: walls at x = ±0.4, y = ±0.3
+  ToolGeometry tool;
+  NudgeParams params;
+  google::protobuf::RepeatedPtrField<v1::Tube> tubes;
+};
+
+TEST_F(NudgeTest, TubeAlongTheMinusYWallIsPushedStraightOffIt) {
+  // Axis 23.5 mm from the wall (11 mm between tube and wall): the last tube of a failed PVC round.
+  *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
+  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->tube_id, 4u);
+  EXPECT_NEAR(plan->direction.y(), 1.0, 1e-12);
+  EXPECT_NEAR(plan->wall_distance, 0.0235, 1e-9);
+  EXPECT_NEAR(std::abs(plan->p_Bin_contact.x()), 0.0, 0.011);  // try 0: the tube's middle
+  // push_gain · (0.15 − 0.0235) = 0.253, clamped to max_push.
+  EXPECT_NEAR(plan->distance, params.max_push, 1e-12);
+  // The closed, tilted tool clears the wall and the floor at the press, along the push and up.
+  EXPECT_FALSE(ToolClearanceProblem(cell, tool, plan->X_BinTcp_press, 0.0,
+                                    {Eigen::Vector3d::Zero(), plan->distance * plan->direction,
+                                     plan->distance * plan->direction + Eigen::Vector3d(0, 0, 0.1)}));
+  // x_Tcp along the push (the housing's narrow side faces the wall), z_Tcp down and towards the
+  // wall by the tilt.
+  const Eigen::Matrix3d R = plan->X_BinTcp_press.linear();
+  EXPECT_NEAR(R.col(2).z(), -std::cos(params.tilt), 1e-9);
+  EXPECT_NEAR(R.col(2).y(), -std::sin(params.tilt), 1e-9);
+  EXPECT_TRUE(R.col(1).isApprox(Eigen::Vector3d::UnitX(), 1e-12));  // closing along the wall
+  // The pads' bottom is press_depth below the tube's top, and the pads still cover it.
+  const Eigen::Vector3d tip = plan->X_BinTcp_press * Eigen::Vector3d(0, 0, tool.finger_tip_depth);
+  EXPECT_NEAR(tip.z(), 2.0 * kR - params.press_depth, 1e-9);
+  EXPECT_LE(plan->shift, 0.5 * tool.finger_size.x() + 0.5 * kR + 1e-9);
+  // Further tries push elsewhere along the tube: 0.3 and 0.7 of its length.
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 1)->p_Bin_contact.x(), -0.25 + 0.3 * 0.5, 0.011);
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 2)->p_Bin_contact.x(), -0.25 + 0.7 * 0.5, 0.011);
+}
+
+TEST_F(NudgeTest, TubeInACornerIsPushedDiagonally) {
+  // Along the +x wall (8 cm from it), its upper end 5 cm from the +y wall.
+  *tubes.Add() = StraightTube(0, {0.32, 0.0, kR}, {0.32, 0.25, kR});
+  params.near_wall_distance = 0.09;
+  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 2);  // 0.7 of the length: y = 0.175
+  ASSERT_TRUE(plan);
+  EXPECT_NEAR(plan->direction.x(), -1.0, 1e-12);  // only the +x wall is within 9 cm of y = 0.175
+  params.near_wall_distance = 0.16;
+  const auto corner = PlanNudge(tubes, cell, tool, params, 0.1, 2);
+  ASSERT_TRUE(corner);
+  EXPECT_NEAR(corner->direction.x(), -std::sqrt(0.5), 1e-9);
+  EXPECT_NEAR(corner->direction.y(), -std::sqrt(0.5), 1e-9);
+}
+
+TEST_F(NudgeTest, NoNudgeForTubesAwayFromTheWallsOrWithoutGeometry) {
+  *tubes.Add() = StraightTube(0, {-0.2, 0.0, kR}, {0.2, 0.0, kR});
+  tubes.Add()->set_id(1);  // no cylinders
+  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, 0.1, 0));
+}
+
+TEST_F(NudgeTest, NonOccludedTubesGoFirstThenTheClosestToAWall) {
+  *tubes.Add() = StraightTube(0, {-0.2, 0.28, kR}, {0.2, 0.28, kR}, v1::OCCLUSION_WEAK);
+  *tubes.Add() = StraightTube(1, {-0.2, -0.25, kR}, {0.2, -0.25, kR});
+  *tubes.Add() = StraightTube(2, {-0.2, -0.26, 3 * kR}, {0.2, -0.26, 3 * kR});
+  EXPECT_EQ(PlanNudge(tubes, cell, tool, params, 0.1, 0)->tube_id, 2u);
+}
+
+TEST_F(NudgeTest, TubeTooDeepInTheCornerOfFloorAndWallIsLeftAlone) {
+  // Touching the wall: the pads cannot cover its top without the tool reaching into the wall.
+  *tubes.Add() = StraightTube(0, {-0.2, -0.3 + kR, kR}, {0.2, -0.3 + kR, kR});
+  params.tilt = 0.0;
+  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, 0.1, 0));
+}
+
+}  // namespace
+}  // namespace tubepick::cell
