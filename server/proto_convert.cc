@@ -116,6 +116,20 @@ v1::PlanPickResponse ToPlanPickResponse(const PickPlanResult& result, const Mode
     pt->set_seconds(t.seconds);
   }
   response.set_total_seconds(result.total_seconds);
+  const PlanningCounts& c = result.counts;
+  v1::PlanningCounts* pc = response.mutable_counts();
+  pc->set_tubes(c.tubes);
+  pc->set_too_short(c.too_short);
+  pc->set_non_occluded(c.non_occluded);
+  pc->set_weakly_occluded(c.weakly_occluded);
+  pc->set_strongly_occluded(c.strongly_occluded);
+  pc->set_trajectories(c.trajectories);
+  pc->set_simulated_trajectories(c.simulated_trajectories);
+  pc->set_grasp_candidates(c.grasp_candidates);
+  pc->set_rejected_section(c.rejected_section);
+  pc->set_rejected_workspace(c.rejected_workspace);
+  pc->set_rejected_tool(c.rejected_tool);
+  pc->set_rejected_fingers(c.rejected_fingers);
   return response;
 }
 

@@ -151,6 +151,14 @@ TEST(RunPlanPick, UnoccludedTubesNeedNoSimulation) {
   EXPECT_NEAR(r.plans(0).grasp().tcp_pose().position().z(), kR, 0.005);
   EXPECT_EQ(r.modeling().tubes_size(), 0);  // the classified tubes above replace them
   EXPECT_EQ(r.modeling().seed(), 3u);
+  // The counts explain the plans: 3 free tubes, no simulation, every accepted candidate is a plan.
+  const v1::PlanningCounts& c = r.counts();
+  EXPECT_EQ(c.tubes(), 3u);
+  EXPECT_EQ(c.non_occluded(), 3u);
+  EXPECT_EQ(c.simulated_trajectories(), 0u);
+  EXPECT_EQ(c.grasp_candidates() - c.rejected_section() - c.rejected_workspace() - c.rejected_tool() -
+                c.rejected_fingers(),
+            static_cast<std::uint64_t>(r.plans_size()));
 }
 
 TEST(RunPlanPick, WovenTubesAreSimulatedAndRankedByCost) {
