@@ -1,12 +1,30 @@
 #pragma once
 
+#include <cmath>
 #include <vector>
+
+#include <string>
 
 #include <Eigen/Geometry>
 
 #include "devices/device_error.h"
 
 namespace tubepick::devices {
+
+/// What the arm can reach and how fast, so a caller can check a plan before moving (a target beyond
+/// the limits is a DeviceFault from the robot itself, often after the arm already moved).
+struct RobotLimits {
+  /// Highest TCP speed, m/s; faster requests are clamped.
+  double max_speed = 0.25;
+  /// Reachable TCP positions, bin frame.
+  Eigen::AlignedBox3d reach_Bin{Eigen::Vector3d(-1.5, -1.5, -0.1), Eigen::Vector3d(1.5, 1.5, 1.5)};
+  /// Wrist joint limit as seen at the TCP: the largest angle between z_Tcp and straight down (−z_Bin)
+  /// the arm reaches, radians.
+  double max_tilt = M_PI / 3.0;
+
+  /// Why X_BinTcp is out of reach (position or tilt), or an empty string when it is reachable.
+  std::string Problem(const Eigen::Isometry3d& X_BinTcp) const;
+};
 
 /// A robot arm moving its tool-centre point (thesis §5.3.1.1). Poses are X_BinTcp: the TCP in the
 /// bin frame (the driver owns the transform to the robot base).
@@ -23,6 +41,8 @@ class Robot {
   virtual Eigen::Isometry3d CurrentPose(Timeout timeout) = 0;
   /// Servo power on. @throws DeviceTimeout, DeviceFault.
   virtual void ServoOn(Timeout timeout) = 0;
+  /// Reach, tilt and speed limits (from the driver's configuration; no device round trip).
+  virtual RobotLimits Limits() const = 0;
 };
 
 }  // namespace tubepick::devices

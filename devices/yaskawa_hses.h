@@ -98,6 +98,9 @@ struct YaskawaHsesParams {
   Eigen::Isometry3d X_BaseBin = Eigen::Isometry3d::Identity();
   /// Used when MoveTo/MoveThrough get a non-positive speed, m/s.
   double default_speed = 0.1;
+  /// Reach (bin frame), tilt and speed limits of this installation (the controller's own soft
+  /// limits are the authority; these let callers skip plans the arm would refuse).
+  RobotLimits limits;
   /// Interval between status polls while a move runs.
   Timeout poll_interval{10};
 };
@@ -115,6 +118,7 @@ class YaskawaHses final : public Robot {
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) override;
   Eigen::Isometry3d CurrentPose(Timeout timeout) override;
   void ServoOn(Timeout timeout) override;
+  RobotLimits Limits() const override { return params_.limits; }
 
   const YaskawaHsesParams& params() const { return params_; }
 

@@ -235,7 +235,6 @@ v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& 
 }
 
 std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& plan, int rank) const {
-  if (!params_.check_tool_clearance) return std::nullopt;
   Eigen::Isometry3d X_grasp;
   try {
     X_grasp = FromWire(plan.grasp().tcp_pose(), fmt::format("plans[{}].grasp.tcp_pose", rank));
@@ -244,6 +243,31 @@ std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& 
   }
   std::vector<Eigen::Vector3d> waypoints;
   for (const v1::Vector3& w : plan.waypoints()) waypoints.push_back(FromWire(w));
+  // The arm's reach and wrist limits: pre-grasp, grasp, every lift waypoint and the placement.
+  const devices::RobotLimits limits = devices_.robot->Limits();
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> poses;
+  Eigen::Isometry3d X_pre = X_grasp;
+  X_pre.translation() -= params_.approach_height * X_grasp.linear().col(2);
+  poses.emplace_back("pre-grasp", X_pre);
+  poses.emplace_back("grasp", X_grasp);
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    Eigen::Isometry3d X = X_grasp;
+    X.translation() += waypoints[i];
+    poses.emplace_back(fmt::format("waypoint {}", i), X);
+  }
+  if (plan.has_place_tcp_pose()) {
+    try {
+      poses.emplace_back("place",
+                         FromWire(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank)));
+    } catch (const InvalidArgument& e) {
+      throw CellFault("planner", FaultKind::kServerError, ToString(state_), e.what());
+    }
+  }
+  for (const auto& [what, X] : poses) {
+    const std::string problem = limits.Problem(X);
+    if (!problem.empty()) return fmt::format("robot limits at the {}: {}", what, problem);
+  }
+  if (!params_.check_tool_clearance) return std::nullopt;
   return ToolClearanceProblem(cell_, params_.tool, X_grasp, plan.grasp().opening_width(), waypoints);
 }
 

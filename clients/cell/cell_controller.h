@@ -93,7 +93,8 @@ struct CellRunResult {
 /// grasp orientation), which is the thesis' "reference with no object held" without the drift and
 /// orientation change between the start of a round and a later pick.
 ///
-/// Plans the tool cannot execute without touching the bin (ToolClearanceProblem) are skipped and
+/// Plans the arm cannot reach (Robot::Limits: pre-grasp, grasp, lift waypoints, placement) or the tool
+/// cannot execute without touching the bin (ToolClearanceProblem) are skipped and
 /// listed in the next record's skipped_plans; a scan without an executable plan is a "no_plan"
 /// record and a rescan — or, when the planner modeled a tube lying along a wall (PlanNudge) and the
 /// nudge limit allows, a "nudge": close the gripper, press on the tube's top, drag it away from the
@@ -136,7 +137,8 @@ class CellController {
   enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed };
 
   void StartCell();
-  /// ToolClearanceProblem for a plan (nullopt when the check is off or the tool stays clear).
+  /// Why a plan cannot be executed: a pose beyond the robot's limits, or ToolClearanceProblem (when
+  /// that check is on); nullopt when it can.
   std::optional<std::string> ClearanceProblem(const v1::PickPlan& plan, int rank) const;
   void ExecutePlan(const v1::PlanPickResponse& response, int plan_index, Attempt& attempt);
   void Place(const Eigen::Isometry3d& X_place, Attempt& attempt);

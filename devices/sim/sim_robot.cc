@@ -50,6 +50,14 @@ void SimRobot::CheckTarget(const Eigen::Isometry3d& X_BinTcp) const {
   }
 }
 
+RobotLimits SimRobot::Limits() const {
+  RobotLimits limits;
+  limits.max_speed = state_.params.robot.max_speed;
+  limits.reach_Bin = state_.workspace;
+  limits.max_tilt = state_.params.robot.max_tilt;
+  return limits;
+}
+
 double SimRobot::EffectiveSpeed(double speed) const {
   const SimRobotParams& r = state_.params.robot;
   if (!(speed > 0.0) || !std::isfinite(speed)) return r.default_speed;

@@ -208,6 +208,32 @@ TEST_F(CellControllerTest, PlansTheToolCannotExecuteAreSkipped) {
   EXPECT_EQ(result.scans, 3u);
 }
 
+TEST_F(CellControllerTest, PlansBeyondTheRobotsLimitsAreSkipped) {
+  // The arm reaches z ≤ 0.35 m: plan 1 lifts 0.4 m, plan 2 only 0.3 m.
+  robot.limits.reach_Bin = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -0.1), Eigen::Vector3d(1, 1.2, 0.35));
+  const std::vector<Eigen::Vector3d> short_lift{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)};
+  planner.plan_answers.push_back(
+      Plans({MakePlan(1, p_grasp), MakePlan(2, p_grasp, v1::TRAJECTORY_KIND_UPWARD, short_lift)}, 2));
+  planner.plan_answers.push_back(Plans({}, 0));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u);
+  const std::vector<json> records = Records("attempt");
+  ASSERT_GE(records.size(), 1u);
+  EXPECT_EQ(records[0]["tube"], 2);
+  ASSERT_EQ(records[0]["skipped_plans"].size(), 1u);
+  const std::string reason = records[0]["skipped_plans"][0]["reason"];
+  EXPECT_NE(reason.find("robot limits at the waypoint 1"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("out of reach"), std::string::npos) << reason;
+  // A tilted wrist beyond the limit is named too.
+  devices::RobotLimits limits;
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();  // z_Tcp up: 180° from straight down
+  EXPECT_NE(limits.Problem(X).find("beyond the wrist limit"), std::string::npos);
+  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();  // z down
+  EXPECT_EQ(limits.Problem(X), "");
+}
+
 TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
   planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 3));
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_NONE, 0.05));

@@ -68,6 +68,8 @@ class ScriptedRobot final : public devices::Robot {
     moves.push_back({false, X_BinTcp, {}, speed});
     pose = X_BinTcp;
   }
+  devices::RobotLimits limits;
+  devices::RobotLimits Limits() const override { return limits; }
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, devices::Timeout) override {
     const int i = throughs++;
     if (fail_always || (fail_through_from && i >= *fail_through_from)) {
