@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cerrno>
+#include <filesystem>
+#include <fstream>
 #include <regex>
 
 #include "tests/cli_test_support.h"
@@ -54,6 +56,80 @@ TEST(CellCliTest, WithoutSimItSaysWhy) {
   const testing::CliRun run = RunCli("cell --rounds 1");
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find("--sim is required"), std::string::npos) << run.output;
+}
+
+void WriteText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+}
+
+TEST(CellCliTest, PrintedControllerConfigIsAcceptedBackByController) {
+  const auto dir = testing::TempDir("cell_controller");
+  const testing::CliRun defaults = RunCli("cell --print-controller-config");
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.output;
+  // Durations in seconds; the command's own --plan-deadline default (300 s) is part of it.
+  EXPECT_NE(defaults.output.find("robot_timeout: 60"), std::string::npos) << defaults.output;
+  EXPECT_NE(defaults.output.find("plan_deadline: 300"), std::string::npos) << defaults.output;
+
+  const auto path = dir / "controller.yaml";
+  WriteText(path, defaults.output);
+  const testing::CliRun back = RunCli("cell --controller " + path.string() + " --print-controller-config");
+  ASSERT_EQ(back.exit_code, 0) << back.output;
+  EXPECT_EQ(back.output, defaults.output);
+
+  // A changed value is used; an option given on the command line overrides the file.
+  std::string text = defaults.output;
+  const std::string lift = "lift_speed: 0.1";
+  ASSERT_NE(text.find(lift), std::string::npos);
+  text.replace(text.find(lift), lift.size(), "lift_speed: 0.2");
+  WriteText(path, text);
+  const testing::CliRun changed =
+      RunCli("cell --controller " + path.string() + " --plan-deadline 42 --print-controller-config");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  EXPECT_NE(changed.output.find("lift_speed: 0.2"), std::string::npos) << changed.output;
+  EXPECT_NE(changed.output.find("plan_deadline: 42"), std::string::npos) << changed.output;
+}
+
+TEST(CellCliTest, ControllerFileWithAnUnknownKeyExits2NamingTheKeyPath) {
+  const auto dir = testing::TempDir("cell_controller_bad");
+  const auto path = dir / "controller.yaml";
+  WriteText(path, "lift_speed: 0.2\nnudge:\n  max_psh: 0.3\n");
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --controller " + path.string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("nudge.max_psh"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(path.string()), std::string::npos) << run.output;
+  // Nothing was started.
+  EXPECT_EQ(run.output.find("started tubepick-server"), std::string::npos) << run.output;
+
+  WriteText(path, "robot_timeout: 0\n");
+  const testing::CliRun zero = RunCli("cell --sim --rounds 1 --controller " + path.string());
+  EXPECT_EQ(zero.exit_code, 2) << zero.output;
+  EXPECT_NE(zero.output.find("robot_timeout: must be positive"), std::string::npos) << zero.output;
+}
+
+TEST(CellCliTest, CellFileWithAnUnknownKeyExits2NamingTheKeyPath) {
+  const auto dir = testing::TempDir("cell_file_bad");
+  const auto path = dir / "cell.yaml";
+  WriteText(path, "bin:\n  inner_sise: [0.8, 0.6, 0.2]\n");
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --cell " + path.string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("bin.inner_sise"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("started tubepick-server"), std::string::npos) << run.output;
+}
+
+TEST(CellCliTest, OneRoundWithACellFileAndAControllerFile) {
+  const auto dir = testing::TempDir("cell_files");
+  const auto cell_path = dir / "cell.yaml";
+  // A larger, deeper bin than the thesis cell, with the thesis' PVC tubes.
+  WriteText(cell_path,
+            "bin:\n  inner_size: [0.9, 0.7, 0.25]\n"
+            "tube:\n  radius: 0.0125\n  length: 0.5\n  mass: 0.055\n");
+  const auto controller_path = dir / "controller.yaml";
+  WriteText(controller_path, "max_attempts_per_bin: 8\ntransit_clearance: 0.25\n");
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 1 --seed 3 --cell " + cell_path.string() +
+                                     " --controller " + controller_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tubes picked"), std::string::npos) << run.output;
 }
 
 }  // namespace

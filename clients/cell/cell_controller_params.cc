@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <string>
 
 #include "core/common/errors.h"
 
@@ -24,10 +25,21 @@ void RequirePositiveCount(std::uint64_t value, const char* field) {
   if (value == 0) throw InvalidArgument(fmt::format("cell controller {}: must be at least 1, got 0", field));
 }
 
+/// Durations are seconds in the YAML (cell_controller_config.h), so the message says seconds.
 void RequirePositiveDuration(std::chrono::milliseconds value, const char* field) {
   if (value.count() <= 0)
-    throw InvalidArgument(
-        fmt::format("cell controller {}: must be positive, got {} ms", field, value.count()));
+    throw InvalidArgument(fmt::format("cell controller {}: must be positive (at least 0.001 s), got {} s",
+                                      field, static_cast<double>(value.count()) / 1000.0));
+}
+
+void RequireVector(const Eigen::Vector3d& v, bool positive, const char* field) {
+  for (int k = 0; k < 3; ++k) {
+    const std::string name = fmt::format("{}[{}]", field, k);
+    if (positive)
+      RequirePositiveValue(v[k], name.c_str());
+    else
+      RequireNonNegativeValue(v[k], name.c_str());
+  }
 }
 
 }  // namespace
@@ -42,12 +54,15 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(release_height, "release_height");
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
-    throw InvalidArgument("cell controller X_BinHome: not finite");
-  if (!tool.finger_size.allFinite() || (tool.finger_size.array() <= 0.0).any() ||
-      !tool.housing_size.allFinite() || (tool.housing_size.array() < 0.0).any() ||
-      !std::isfinite(tool.finger_tip_depth) || !std::isfinite(tool.housing_gap) ||
-      !std::isfinite(tool.margin))
-    throw InvalidArgument("cell controller tool: sizes must be finite, finger sizes positive");
+    throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");
+  // The same ranges as the planner's planning.tool (PlanningParams::Validate).
+  RequireVector(tool.finger_size, true, "tool.finger_size");
+  RequireVector(tool.housing_size, false, "tool.housing_size");
+  if (!std::isfinite(tool.finger_tip_depth))
+    throw InvalidArgument(
+        fmt::format("cell controller tool.finger_tip_depth: must be finite, got {}", tool.finger_tip_depth));
+  RequireNonNegativeValue(tool.housing_gap, "tool.housing_gap");
+  RequireNonNegativeValue(tool.margin, "tool.margin");
   RequireNonNegativeValue(nudge.near_wall_distance, "nudge.near_wall_distance");
   RequireNonNegativeValue(nudge.target_wall_distance, "nudge.target_wall_distance");
   RequireNonNegativeValue(nudge.push_gain, "nudge.push_gain");
@@ -57,6 +72,9 @@ void CellControllerParams::Validate() const {
     throw InvalidArgument(fmt::format("cell controller nudge.min_push: {} exceeds nudge.max_push {}",
                                       nudge.min_push, nudge.max_push));
   RequireNonNegativeValue(nudge.press_depth, "nudge.press_depth");
+  if (!std::isfinite(nudge.tilt) || nudge.tilt < 0.0 || nudge.tilt >= M_PI / 2)
+    throw InvalidArgument(
+        fmt::format("cell controller nudge.tilt: must be in [0, pi/2) rad, got {}", nudge.tilt));
   RequirePositiveValue(nudge.speed, "nudge.speed");
   RequirePositiveValue(nudge.sample_spacing, "nudge.sample_spacing");
   RequirePositiveValue(gripper_speed, "gripper_speed");

@@ -18,6 +18,8 @@ namespace tubepick::cell {
 /// Everything the cell controller decides by itself: speeds, heights, the planner options, the
 /// attempt limits and the timeouts. Every field has a default that suits the simulated cell and the
 /// thesis' setup (§5.3); poses are X_BinTcp (TCP in the bin frame, z down along the approach).
+/// As YAML: ParseCellControllerParams / LoadCellControllerParams / DumpCellControllerParams
+/// (cell_controller_config.h; the keys are these field names, durations in seconds).
 struct CellControllerParams {
   // --- motion ---
   /// Free moves between poses (home, transit, above the place frame), m/s.

@@ -4,16 +4,19 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <memory>
 
 #include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_controller_config.h"
 #include "clients/cell/cell_records.h"
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
 #include "clients/cell/sim_round.h"
 #include "clients/cli/cell_server_process.h"
 #include "clients/cli/cell_tables.h"
+#include "core/common/cell_config.h"
 #include "core/common/errors.h"
 #include "devices/sim/sim_cell.h"
 
@@ -36,6 +39,13 @@ struct CellOptions {
   bool no_sim_planning = false;
   double plan_deadline = 300.0;
   std::uint32_t max_attempts_per_tube = 0;
+  std::string controller_path;  ///< empty = the controller's defaults
+  bool print_controller_config = false;
+  std::string cell_path;  ///< empty = the thesis cell for --material
+  // Options given on the command line (they override --controller).
+  bool profile_given = false;
+  bool resolution_given = false;
+  bool plan_deadline_given = false;
 };
 
 v1::ResolutionVariant ParseVariant(const std::string& name) {
@@ -50,17 +60,41 @@ v1::ResolutionVariant ParseVariant(const std::string& name) {
                   name));
 }
 
+/// The controller parameters of every round but the seed: --controller (or the defaults), then the
+/// options given on the command line. Without --controller, --plan-deadline applies with its default
+/// (300 s) as before.
+cell::CellControllerParams ControllerParams(const CellOptions& o) {
+  cell::CellControllerParams params = o.controller_path.empty()
+                                          ? cell::CellControllerParams{}
+                                          : cell::LoadCellControllerParams(o.controller_path);
+  if (o.profile_given) params.profile = o.profile;
+  if (o.resolution_given) params.resolution_variant = ParseVariant(o.resolution);
+  if (o.no_sim_planning) params.disable_simulation = true;
+  if (o.controller_path.empty() || o.plan_deadline_given) {
+    if (!(o.plan_deadline > 0.0))
+      throw InvalidArgument(fmt::format("--plan-deadline: must be positive, got {}", o.plan_deadline));
+    params.plan_deadline = std::chrono::milliseconds(std::llround(o.plan_deadline * 1000.0));
+  }
+  if (o.max_attempts_per_tube > 0) params.max_attempts_per_tube = o.max_attempts_per_tube;
+  params.Validate();
+  return params;
+}
+
 void Run(const CellOptions& o) {
+  const cell::CellControllerParams base_params = ControllerParams(o);
+  if (o.print_controller_config) {
+    fmt::print("{}", cell::DumpCellControllerParams(base_params));
+    return;
+  }
+  const bool custom_cell = !o.cell_path.empty();
+  const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
   if (!o.sim)
     throw InvalidArgument(
         "--sim is required: the cell command drives the simulated cell (the real drivers "
         "in devices/ are not wired to this command yet)");
   if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
   if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
-  if (!(o.plan_deadline > 0.0))
-    throw InvalidArgument(fmt::format("--plan-deadline: must be positive, got {}", o.plan_deadline));
   const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
-  const v1::ResolutionVariant variant = ParseVariant(o.resolution);
 
   std::unique_ptr<ServerProcess> server;
   std::string address = o.server;
@@ -84,16 +118,12 @@ void Run(const CellOptions& o) {
   json rounds_json = json::array();
   bool any_fault = false;
   for (std::uint32_t round = 0; round < o.rounds; ++round) {
-    cell::CellControllerParams params;
+    cell::CellControllerParams params = base_params;
     params.seed = (o.seed + round) * 1000;
-    params.profile = o.profile;
-    params.disable_simulation = o.no_sim_planning;
-    params.resolution_variant = variant;
-    params.plan_deadline = std::chrono::milliseconds(static_cast<std::int64_t>(o.plan_deadline * 1000.0));
-    if (o.max_attempts_per_tube > 0) params.max_attempts_per_tube = o.max_attempts_per_tube;
-    const cell::SimRoundResult r =
-        cell::RunSimRound(planner, devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round),
-                          params, round, &sink);
+    devices::sim::SimCellParams sim_params =
+        devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
+    if (custom_cell) sim_params.cell = cell_config;
+    const cell::SimRoundResult r = cell::RunSimRound(planner, sim_params, params, round, &sink);
     const cell::CellRunResult& result = r.run;
     const std::uint32_t left = r.tubes_in_bin;
     const double wall = r.wall_s;
@@ -166,16 +196,37 @@ void AddCellCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--records", o->records_path, "Write every attempt as a JSON line to this file");
   cmd->add_option("--json", o->json_path, "Write the per-round results and the statistics as JSON");
-  cmd->add_option("--profile", o->profile, "Planner parameter profile (fast, thesis; default: the server's)");
-  cmd->add_option("--resolution", o->resolution,
-                  "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe "
-                  "(default: the server's)");
+  CLI::Option* profile = cmd->add_option("--profile", o->profile,
+                                         "Planner parameter profile (fast, thesis; default: the server's)");
+  CLI::Option* resolution =
+      cmd->add_option("--resolution", o->resolution,
+                      "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe "
+                      "(default: the server's)");
   cmd->add_flag("--no-sim-planning", o->no_sim_planning, "Ask the planner not to simulate trajectories");
-  cmd->add_option("--plan-deadline", o->plan_deadline, "PlanPick deadline per try, seconds")
-      ->capture_default_str();
+  CLI::Option* plan_deadline =
+      cmd->add_option("--plan-deadline", o->plan_deadline,
+                      "PlanPick deadline per try, seconds (with --controller: only when given)")
+          ->capture_default_str();
   cmd->add_option("--max-attempts-per-tube", o->max_attempts_per_tube,
                   "Attempts since the last pick before the round stops (0 = controller default)");
-  cmd->callback([o] { Run(*o); });
+  cmd->add_option("--controller", o->controller_path,
+                  "Cell controller parameters YAML (deploy/cell-controller.example.yaml; strict: unknown "
+                  "keys are errors). Options given here override it; the planner seed of round r is "
+                  "always (--seed + r)·1000")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--print-controller-config", o->print_controller_config,
+                "Print the controller parameters this command would use (defaults, --controller, the "
+                "options given) as YAML and exit");
+  cmd->add_option("--cell", o->cell_path,
+                  "Cell YAML (bin, sensor, place, tube) for the simulated cell and the planner requests "
+                  "(default: the thesis cell for --material)")
+      ->check(CLI::ExistingFile);
+  cmd->callback([o, profile, resolution, plan_deadline] {
+    o->profile_given = profile->count() > 0;
+    o->resolution_given = resolution->count() > 0;
+    o->plan_deadline_given = plan_deadline->count() > 0;
+    Run(*o);
+  });
 }
 
 }  // namespace tubepick::cli
