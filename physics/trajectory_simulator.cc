@@ -269,6 +269,15 @@ TrajectoryRun SettledTubes::RunImpl(const Trajectory& trajectory, const StopToke
   return run;
 }
 
+TrajectorySimParams SimParamsForCell(TrajectorySimParams base, const CellConfig& cell, double disp_max,
+                                     int threads) {
+  base.bin = cell.bin;
+  base.tube_mass = cell.tube.mass;
+  base.disp_max = disp_max;
+  base.threads = threads;
+  return base;
+}
+
 BulletTrajectoryEvaluator::BulletTrajectoryEvaluator(TrajectorySimParams params)
     : params_(std::move(params)) {
   params_.Validate();

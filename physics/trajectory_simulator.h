@@ -147,6 +147,11 @@ class SettledTubes {
   double settle_seconds_ = 0.0;
 };
 
+/// `base` set up for one cell and parameter profile: the cell's bin and tube mass, the profile's
+/// disp_max (planning.cost.max_displacement) and `threads` workers (0 = all cores).
+TrajectorySimParams SimParamsForCell(TrajectorySimParams base, const CellConfig& cell, double disp_max,
+                                     int threads);
+
 /// The Bullet physics backend of trajectory evaluation: settles the tubes once, then simulates the
 /// trajectories on a pool of `threads` workers, each in a fresh world of its own (clone per
 /// thread). Outcomes are bitwise the same whatever the thread count. Bullet's solver draws no

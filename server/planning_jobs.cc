@@ -37,12 +37,8 @@ v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults&
 
   std::unique_ptr<physics::BulletTrajectoryEvaluator> evaluator;
   if (!job.disable_simulation) {
-    physics::TrajectorySimParams sim = defaults.simulation;
-    sim.bin = job.cell.bin;
-    sim.tube_mass = job.cell.tube.mass;
-    sim.disp_max = job.params.planning.cost.max_displacement;
-    sim.threads = simulation_threads;
-    evaluator = std::make_unique<physics::BulletTrajectoryEvaluator>(sim);
+    evaluator = std::make_unique<physics::BulletTrajectoryEvaluator>(physics::SimParamsForCell(
+        defaults.simulation, job.cell, job.params.planning.cost.max_displacement, simulation_threads));
   }
   PickPlanResult plan = PlanPick(modeling, job.cell, job.params.planning, evaluator.get(), job.seed, stop);
   // Truncate first: placements are computed only for the plans that are sent.
@@ -56,9 +52,7 @@ v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job) {
   std::optional<ResolutionPlan> resolution;
   Eigen::Vector3d delta_torque_Tcp = Eigen::Vector3d::Zero();
   if (count.outcome == HeldOutcome::kMultiple) {
-    const Eigen::Vector3d up = job.params.up_Tcp.normalized();
-    const Eigen::Vector3d delta = job.current.torque - job.reference.torque;
-    delta_torque_Tcp = delta - delta.dot(up) * up;  // Eq. 5.7, as PlanResolutionRotation does
+    delta_torque_Tcp = HorizontalTorqueChange(job.reference, job.current, job.params.up_Tcp);
     resolution = PlanResolutionRotation(job.reference, job.current, job.X_BinTcp, job.params);
   }
   return ToAnalyzeWrenchResponse(count, resolution, delta_torque_Tcp);

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "core/common/errors.h"
+#include "core/common/packed_cloud.h"
 #include "server/proto_convert.h"
 
 namespace tubepick::server {
@@ -165,22 +166,7 @@ Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::st
     throw InvalidArgument(field + ": " + std::to_string(count) + " points exceed the limit of " +
                           std::to_string(max_points) + " (planning.max_cloud_points)");
   }
-  Points points(count);
-  if constexpr (std::endian::native == std::endian::little) {
-    static_assert(sizeof(Eigen::Vector3f) == 12);
-    std::memcpy(static_cast<void*>(points.data()), xyz.data(), xyz.size());
-  } else {
-    for (std::uint64_t i = 0; i < count; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        std::uint32_t bits = 0;
-        for (int b = 0; b < 4; ++b) {
-          bits |= static_cast<std::uint32_t>(static_cast<unsigned char>(xyz[12 * i + 4 * k + b])) << (8 * b);
-        }
-        points[i][k] = std::bit_cast<float>(bits);
-      }
-    }
-  }
-  return points;
+  return UnpackXyz(xyz);
 }
 
 CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults& defaults,

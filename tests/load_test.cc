@@ -14,6 +14,7 @@
 #include "clients/cli/load_engine.h"
 #include "clients/cli/load_metrics.h"
 #include "core/common/errors.h"
+#include "core/common/packed_cloud.h"
 #include "core/modeling/cloud_io.h"
 #include "server/planner_server.h"
 #include "server/server_config.h"
@@ -57,7 +58,7 @@ const Points& SceneCloud(std::uint32_t every) {
   return points;
 }
 
-LoadCloud GoodCloud() { return {"scene", PackCloudXyz(SceneCloud(20)), v1::LENGTH_UNIT_METRE}; }
+LoadCloud GoodCloud() { return {"scene", PackXyz(SceneCloud(20)), v1::LENGTH_UNIT_METRE}; }
 /// 13 bytes: not a whole number of points, which the server must answer INVALID_ARGUMENT.
 LoadCloud BadCloud() { return {"bad", std::string(13, '\x01'), v1::LENGTH_UNIT_METRE}; }
 
@@ -70,19 +71,6 @@ void ExpectOrdered(const LatencySummary& l) {
   EXPECT_LE(l.p99, l.max);
   EXPECT_GE(l.mean, l.min);
   EXPECT_LE(l.mean, l.max);
-}
-
-TEST(LoadEngine, PackCloudXyzIsLittleEndianFloat32) {
-  const Points points = {Eigen::Vector3f(1.0f, -2.5f, 0.125f)};
-  const std::string xyz = PackCloudXyz(points);
-  ASSERT_EQ(xyz.size(), 12u);
-  // 1.0f = 0x3F800000, stored least significant byte first.
-  EXPECT_EQ(static_cast<unsigned char>(xyz[0]), 0x00);
-  EXPECT_EQ(static_cast<unsigned char>(xyz[3]), 0x3F);
-  EXPECT_EQ(static_cast<unsigned char>(xyz[2]), 0x80);
-  float y = 0.0f;
-  std::memcpy(&y, xyz.data() + 4, 4);
-  EXPECT_EQ(y, -2.5f);
 }
 
 TEST(LoadEngine, SummarizeLatencyNearestRank) {
@@ -227,7 +215,7 @@ TEST(LoadAgainstServer, ExpiredDeadlinesAreCountedByCode) {
   o.concurrency = 1;
   o.total = 2;
   o.deadline_seconds = 0.001;  // far below one plan of 2.3 M points
-  const LoadReport r = RunLoad(o, {{"full", PackCloudXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
+  const LoadReport r = RunLoad(o, {{"full", PackXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
   EXPECT_EQ(r.total, 2u);
   EXPECT_EQ(r.ok, 0u);
   EXPECT_EQ(r.status_counts.at("DEADLINE_EXCEEDED"), 2u);
@@ -242,7 +230,7 @@ TEST(LoadAgainstServer, FullQueueIsCountedAsResourceExhausted) {
   o.rpc = LoadRpc::kModelTubes;
   o.concurrency = 4;
   o.total = 8;
-  const LoadReport r = RunLoad(o, {{"full", PackCloudXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
+  const LoadReport r = RunLoad(o, {{"full", PackXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});
   EXPECT_EQ(r.total, 8u);
   EXPECT_GE(r.ok, 1u);
   ASSERT_TRUE(r.status_counts.contains("RESOURCE_EXHAUSTED")) << FormatLoadReportText(r);

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/common/packed_cloud.h"
 #include "core/params.h"
 #include "core/testing/synthetic_cloud.h"
 #include "physics/scene_generator.h"
@@ -208,18 +209,7 @@ std::unique_ptr<v1::PickPlannerService::Stub> TestServer::NewStub() const {
       grpc::CreateCustomChannel(target(), grpc::InsecureChannelCredentials(), args));
 }
 
-std::string PackCloud(const Points& points) {
-  std::string out(points.size() * 12, '\0');
-  char* p = out.data();
-  for (const Eigen::Vector3f& v : points) {
-    for (int i = 0; i < 3; ++i) {
-      const float f = v[i];
-      std::memcpy(p, &f, 4);  // x86-64 is little-endian, as the wire format
-      p += 4;
-    }
-  }
-  return out;
-}
+std::string PackCloud(const Points& points) { return PackXyz(points); }
 
 const std::string& ThreeTubeCloud() {
   static const std::string cloud = [] {

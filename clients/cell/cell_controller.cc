@@ -9,11 +9,27 @@
 
 #include "clients/cell/wire_convert.h"
 #include "core/common/errors.h"
+#include "core/common/packed_cloud.h"
 
 namespace tubepick::cell {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// The plan's unit approach direction; the TCP's z axis when the plan gives none.
+Eigen::Vector3d ApproachOf(const v1::PickPlan& plan, const Eigen::Isometry3d& X_grasp) {
+  Eigen::Vector3d approach = FromWire(plan.grasp().approach());
+  if (!approach.allFinite() || approach.norm() < 1e-9) approach = X_grasp.linear().col(2);
+  return approach.normalized();
+}
+
+/// The grasp pose backed off `height` against the approach direction.
+Eigen::Isometry3d PreGraspPose(const Eigen::Isometry3d& X_grasp, const Eigen::Vector3d& approach,
+                               double height) {
+  Eigen::Isometry3d X_pre = X_grasp;
+  X_pre.translation() -= height * approach;
+  return X_pre;
+}
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -150,25 +166,24 @@ devices::Capture CellController::Scan() {
   return CallDevice("scanner", state_, [&] { return devices_.scanner->Scan(params_.scanner_timeout); });
 }
 
-void CellController::MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt) {
+template <typename Motion>
+void CellController::TimedRobotMotion(Attempt* attempt, const Motion& motion) {
   const Clock::time_point start = Clock::now();
   const double device_start = DeviceNow();
-  CallDevice("robot", state_, [&] { devices_.robot->MoveTo(X_BinTcp, speed, params_.robot_timeout); });
+  CallDevice("robot", state_, motion);
   if (attempt) {
     attempt->robot_wall_s += SecondsSince(start);
     attempt->robot_device_s += DeviceNow() - device_start;
   }
 }
 
+void CellController::MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt) {
+  TimedRobotMotion(attempt, [&] { devices_.robot->MoveTo(X_BinTcp, speed, params_.robot_timeout); });
+}
+
 void CellController::MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed,
                                  Attempt* attempt) {
-  const Clock::time_point start = Clock::now();
-  const double device_start = DeviceNow();
-  CallDevice("robot", state_, [&] { devices_.robot->MoveThrough(waypoints, speed, params_.robot_timeout); });
-  if (attempt) {
-    attempt->robot_wall_s += SecondsSince(start);
-    attempt->robot_device_s += DeviceNow() - device_start;
-  }
+  TimedRobotMotion(attempt, [&] { devices_.robot->MoveThrough(waypoints, speed, params_.robot_timeout); });
 }
 
 Eigen::Isometry3d CellController::CurrentPose() {
@@ -246,9 +261,7 @@ std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& 
   // The arm's reach and wrist limits: pre-grasp, grasp, every lift waypoint and the placement.
   const devices::RobotLimits limits = devices_.robot->Limits();
   std::vector<std::pair<std::string, Eigen::Isometry3d>> poses;
-  Eigen::Isometry3d X_pre = X_grasp;
-  X_pre.translation() -= params_.approach_height * X_grasp.linear().col(2);
-  poses.emplace_back("pre-grasp", X_pre);
+  poses.emplace_back("pre-grasp", PreGraspPose(X_grasp, ApproachOf(plan, X_grasp), params_.approach_height));
   poses.emplace_back("grasp", X_grasp);
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
     Eigen::Isometry3d X = X_grasp;
@@ -306,17 +319,14 @@ void CellController::ExecutePlan(const v1::PlanPickResponse& response, int plan_
   if (plan.waypoints_size() == 0)
     throw CellFault("planner", FaultKind::kServerError, ToString(CellState::kPlan),
                     field + ".waypoints: empty (a trajectory starts with (0, 0, 0))");
-  Eigen::Vector3d approach = FromWire(plan.grasp().approach());
-  if (!approach.allFinite() || approach.norm() < 1e-9) approach = X_grasp.linear().col(2);
-  approach.normalize();
+  const Eigen::Vector3d approach = ApproachOf(plan, X_grasp);
   rec["grasp"] = {{"tcp_pose", PoseJson(X_grasp)},
                   {"approach", Vec(approach)},
                   {"opening_width", plan.grasp().opening_width()}};
 
   // Approach: transit to the pre-grasp pose, open to the grasp width.
   Enter(CellState::kApproach);
-  Eigen::Isometry3d X_pre = X_grasp;
-  X_pre.translation() -= params_.approach_height * approach;
+  const Eigen::Isometry3d X_pre = PreGraspPose(X_grasp, approach, params_.approach_height);
   TransitTo(X_pre, &attempt);
   if (plan.grasp().opening_width() > 0.0) {
     CheckGripper(CallDevice("gripper", state_, [&] {
@@ -554,7 +564,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
 
         Enter(CellState::kPlan);
         v1::PlanPickRequest request;
-        *request.mutable_cloud()->mutable_xyz() = PackCloudXyz(capture.points_Sensor);
+        *request.mutable_cloud()->mutable_xyz() = PackXyz(capture.points_Sensor);
         request.mutable_cloud()->set_unit(ToWire(capture.unit));
         *request.mutable_cell() = ToCellDescription(cell_, capture.X_BinSensor);
         request.mutable_options()->set_profile(params_.profile);

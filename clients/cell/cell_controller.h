@@ -152,6 +152,9 @@ class CellController {
 
   // Devices, each call timed and its failures turned into CellFault.
   devices::Capture Scan();
+  /// Runs a robot motion through CallDevice and adds its wall and device time to `attempt`.
+  template <typename Motion>
+  void TimedRobotMotion(Attempt* attempt, const Motion& motion);
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Attempt* attempt);
   Eigen::Isometry3d CurrentPose();

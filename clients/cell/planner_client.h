@@ -8,6 +8,7 @@
 
 #include <grpcpp/support/status.h>
 
+#include "proto/grpc_status_name.h"
 #include "tubepick/v1/planning.pb.h"
 #include "tubepick/v1/requests.pb.h"
 #include "tubepick/v1/wrench.pb.h"
@@ -32,9 +33,6 @@ class PlannerError : public std::runtime_error {
   std::string message_;
   std::uint32_t tries_;
 };
-
-/// "OK", "UNAVAILABLE", "RESOURCE_EXHAUSTED", ... (the canonical names).
-std::string StatusCodeName(grpc::StatusCode code);
 
 /// The planning service as the cell controller sees it (PickPlannerService, proto/tubepick/v1).
 /// Both calls block until the answer, the deadline or the last retry.

@@ -59,18 +59,6 @@ v1::LengthUnit ToWire(LengthUnit unit) {
   return unit == LengthUnit::kMillimetre ? v1::LENGTH_UNIT_MILLIMETRE : v1::LENGTH_UNIT_METRE;
 }
 
-std::string PackCloudXyz(const Points& points) {
-  std::string bytes(points.size() * 12, '\0');
-  std::size_t i = 0;
-  for (const Eigen::Vector3f& p : points) {
-    for (int axis = 0; axis < 3; ++axis) {
-      const std::uint32_t bits = std::bit_cast<std::uint32_t>(p[axis]);
-      for (int b = 0; b < 4; ++b) bytes[i++] = static_cast<char>((bits >> (8 * b)) & 0xffu);
-    }
-  }
-  return bytes;
-}
-
 v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isometry3d& X_BinSensor) {
   v1::CellDescription out;
   *out.mutable_bin_inner_size() = ToWire(cell.bin.inner_size);

@@ -26,9 +26,6 @@ Eigen::Isometry3d FromWire(const v1::Pose& pose, const std::string& field);
 v1::Wrench ToWire(const devices::WrenchReading& reading);
 v1::LengthUnit ToWire(LengthUnit unit);
 
-/// Packs points into PointCloud.xyz: little-endian float32 x, y, z per point, 12 bytes a point.
-std::string PackCloudXyz(const Points& points);
-
 /// The CellDescription of `cell` with the sensor pose of the capture (X_BinSensor).
 v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isometry3d& X_BinSensor);
 

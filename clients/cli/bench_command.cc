@@ -186,12 +186,8 @@ void RunPlanBench(const PlanBenchOptions& o) {
   std::vector<double> sim_seconds;
   double displacement_sum = 0.0;
   for (int threads : {1, 2}) {
-    physics::TrajectorySimParams sim;
-    sim.bin = cell.bin;
-    sim.tube_mass = cell.tube.mass;
-    sim.disp_max = params.planning.cost.max_displacement;
-    sim.threads = threads;
-    physics::BulletTrajectoryEvaluator evaluator(sim);
+    physics::BulletTrajectoryEvaluator evaluator(
+        physics::SimParamsForCell({}, cell, params.planning.cost.max_displacement, threads));
     std::vector<TrajectoryOutcome> outcomes;
     sim_seconds.push_back(MedianSeconds(o.repetitions, [&] {
       outcomes = evaluator.Evaluate(classes.tubes, candidates, o.common.seed, nullptr);

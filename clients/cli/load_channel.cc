@@ -39,17 +39,6 @@ void AddChannelOptions(CLI::App* cmd, ChannelOptions& o) {
       ->check(CLI::IsMember({"pick_first", "round_robin"}));
 }
 
-std::string StatusCodeName(grpc::StatusCode code) {
-  static constexpr const char* kNames[] = {
-      "OK",        "CANCELLED",      "UNKNOWN",           "INVALID_ARGUMENT",   "DEADLINE_EXCEEDED",
-      "NOT_FOUND", "ALREADY_EXISTS", "PERMISSION_DENIED", "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION",
-      "ABORTED",   "OUT_OF_RANGE",   "UNIMPLEMENTED",     "INTERNAL",           "UNAVAILABLE",
-      "DATA_LOSS", "UNAUTHENTICATED"};
-  const int i = static_cast<int>(code);
-  if (i >= 0 && i < static_cast<int>(std::size(kNames))) return kNames[i];
-  return fmt::format("CODE_{}", i);
-}
-
 std::shared_ptr<grpc::Channel> MakeChannel(const ChannelOptions& o) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(-1);

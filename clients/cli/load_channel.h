@@ -7,6 +7,8 @@
 #include <grpcpp/support/status.h>
 #include <CLI/CLI.hpp>
 
+#include "proto/grpc_status_name.h"
+
 namespace tubepick::cli {
 
 /// Where and how a client command reaches a tubepick-server (shared by `load` and `health`).
@@ -30,8 +32,5 @@ void AddChannelOptions(CLI::App* cmd, ChannelOptions& options);
 /// A channel with unlimited message sizes (the server enforces its own limit).
 /// @throws InvalidArgument when a TLS file cannot be read or TLS options are inconsistent.
 std::shared_ptr<grpc::Channel> MakeChannel(const ChannelOptions& options);
-
-/// Canonical upper-case name of a gRPC status code ("OK", "RESOURCE_EXHAUSTED", ...).
-std::string StatusCodeName(grpc::StatusCode code);
 
 }  // namespace tubepick::cli

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "core/common/errors.h"
+#include "core/common/packed_cloud.h"
 #include "core/modeling/cloud_io.h"
 #include "server/cloud_stream.h"
 #include "tubepick/v1/requests.pb.h"
@@ -220,21 +221,6 @@ LoadRpc ParseLoadRpc(const std::string& name) {
   throw InvalidArgument("--rpc: '" + name + "' is not plan, model or plan-stream");
 }
 
-std::string PackCloudXyz(const Points& points) {
-  static_assert(sizeof(float) == 4);
-  std::string xyz(points.size() * 12, '\0');
-  char* out = xyz.data();
-  for (const Eigen::Vector3f& p : points) {
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t bits = std::bit_cast<std::uint32_t>(p[k]);
-      if constexpr (std::endian::native == std::endian::big) bits = __builtin_bswap32(bits);
-      std::memcpy(out, &bits, 4);
-      out += 4;
-    }
-  }
-  return xyz;
-}
-
 std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUnit unit) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(directory)) throw InvalidArgument("--clouds: '" + directory + "' is not a directory");
@@ -250,7 +236,7 @@ std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUn
   std::vector<LoadCloud> clouds;
   for (const fs::path& f : files) {
     CloudFile file = ReadCloudFile(f.string());
-    clouds.push_back({f.string(), PackCloudXyz(file.points), unit});
+    clouds.push_back({f.string(), PackXyz(file.points), unit});
   }
   return clouds;
 }

@@ -32,9 +32,6 @@ struct LoadCloud {
   v1::LengthUnit unit = v1::LENGTH_UNIT_UNSPECIFIED;
 };
 
-/// Packs points as PointCloud.xyz (12 bytes a point, little endian).
-std::string PackCloudXyz(const Points& points);
-
 /// Every *.ply and *.pcd file at or below `directory` (e.g. a tree of `tubepick scene` outputs),
 /// sorted by path, read with ReadCloudFile and packed; non-finite points are kept (the server
 /// drops them). @throws InvalidArgument when the directory holds no cloud or a file is unreadable.

@@ -44,12 +44,8 @@ void Run(const PlanOptions& o) {
   const ModelingInput input = MakeModelingInput(cloud, cell, common.seed);
   const ModelingResult modeling = ModelTubes(input, params.modeling);
 
-  physics::TrajectorySimParams sim;
-  sim.bin = cell.bin;
-  sim.tube_mass = cell.tube.mass;
-  sim.disp_max = params.planning.cost.max_displacement;
-  sim.threads = static_cast<int>(o.sim_threads);
-  physics::BulletTrajectoryEvaluator evaluator(sim);
+  physics::BulletTrajectoryEvaluator evaluator(physics::SimParamsForCell(
+      {}, cell, params.planning.cost.max_displacement, static_cast<int>(o.sim_threads)));
   PickPlanResult plan =
       PlanPick(modeling, cell, params.planning, o.no_sim ? nullptr : &evaluator, common.seed);
   AttachPlacements(modeling, cell.place.X_BinPlace, params.placement, &plan);

@@ -9,6 +9,7 @@
 #include "clients/cli/cli_inputs.h"
 #include "clients/cli/load_engine.h"
 #include "core/common/errors.h"
+#include "core/common/packed_cloud.h"
 #include "core/modeling/cloud_io.h"
 #include "server/cloud_stream.h"
 #include "server/proto_convert.h"
@@ -73,7 +74,7 @@ std::string FillPlanningRequest(const RequestOptions& o, const CellConfig& cell,
     for (std::size_t i = 0; i < points.size(); i += o.every) kept.push_back(points[i]);
     points = std::move(kept);
   }
-  request->mutable_cloud()->set_xyz(PackCloudXyz(points));
+  request->mutable_cloud()->set_xyz(PackXyz(points));
   request->mutable_cloud()->set_unit(unit);
   if (!o.cell_path.empty()) *request->mutable_cell() = ToCellDescription(cell);
   v1::PlanningOptions* options = request->mutable_options();

@@ -136,6 +136,13 @@ ResolutionMotion JointSafe(const Eigen::Vector3d& torque_axis_Tcp, const Eigen::
 
 }  // namespace
 
+Eigen::Vector3d HorizontalTorqueChange(const Wrench& reference, const Wrench& current,
+                                       const Eigen::Vector3d& up_Tcp) {
+  const Eigen::Vector3d up = up_Tcp.normalized();
+  const Eigen::Vector3d delta = current.torque - reference.torque;
+  return delta - delta.dot(up) * up;
+}
+
 std::optional<ResolutionPlan> PlanResolutionRotation(const Wrench& reference, const Wrench& current,
                                                      const Eigen::Isometry3d& X_BinTcp,
                                                      const WrenchParams& params) {
@@ -154,10 +161,8 @@ std::optional<ResolutionPlan> PlanResolutionRotation(const Wrench& reference, co
                           "): the gripper must be vertical at lift, or wrench.up_Tcp is wrong");
   }
 
-  // Eq. 5.7: the vertical component is dropped (exactly [ΔMx, ΔMy, 0] when up_Tcp = ±z).
-  const Eigen::Vector3d delta = current.torque - reference.torque;
   ResolutionPlan plan;
-  plan.delta_torque_Tcp = delta - delta.dot(up_Tcp) * up_Tcp;
+  plan.delta_torque_Tcp = HorizontalTorqueChange(reference, current, up_Tcp);
   const double magnitude = plan.delta_torque_Tcp.norm();
   if (!(magnitude >= params.min_torque)) return std::nullopt;
   plan.torque_axis_Tcp = plan.delta_torque_Tcp / magnitude;

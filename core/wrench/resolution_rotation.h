@@ -45,6 +45,11 @@ struct ResolutionPlan {
   std::vector<ResolutionMotion> motions;
 };
 
+/// ΔM = M − M_ref with its component along up_Tcp removed (Eq. 5.7: exactly [ΔMx, ΔMy, 0] when
+/// up_Tcp = ±z), N·m, in Tcp. up_Tcp is normalised here.
+Eigen::Vector3d HorizontalTorqueChange(const Wrench& reference, const Wrench& current,
+                                       const Eigen::Vector3d& up_Tcp);
+
 /// Entanglement-resolution rotation (§5.2.6) and its variants (params.variant, see
 /// ResolutionVariant). Readings are in the sensor frame, whose axes are the TCP's (wrench.h).
 /// @param reference reading with the gripper empty (M_x_ref, M_y_ref).

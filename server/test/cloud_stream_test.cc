@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/common/errors.h"
+#include "server/test/error_of.h"
 
 namespace tubepick::server {
 namespace {
@@ -49,18 +50,6 @@ std::vector<std::string> Split(const std::string& bytes, std::uint32_t n) {
   for (std::uint32_t i = 0; i < n; ++i)
     chunks.push_back(bytes.substr(std::min(bytes.size(), i * size), size));
   return chunks;
-}
-
-// Runs `f` and returns the InvalidArgument message (fails when nothing is thrown).
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InvalidArgument";
-  return "";
 }
 
 TEST(Crc32c, KnownVectors) {

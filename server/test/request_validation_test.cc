@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/common/errors.h"
+#include "server/test/error_of.h"
 
 namespace tubepick::server {
 namespace {
@@ -20,17 +21,6 @@ using ::testing::HasSubstr;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InvalidArgument";
-  return "";
-}
 
 std::string Encode(const std::vector<Eigen::Vector3f>& points) {
   std::string bytes(points.size() * 12, '\0');

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/common/errors.h"
+#include "server/test/error_of.h"
 
 namespace tubepick::server {
 namespace {
@@ -14,17 +15,6 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InvalidArgument";
-  return "";
-}
 
 std::string ParseError(const std::string& yaml) {
   return ErrorOf([&] { ParseServerConfig(yaml); });

@@ -9,21 +9,6 @@
 namespace tubepick::cell {
 namespace {
 
-TEST(WireConvertTest, CloudIsPackedLittleEndianFloat32) {
-  const Points points = {Eigen::Vector3f(1.0f, -2.0f, 0.5f)};
-  const std::string xyz = PackCloudXyz(points);
-  ASSERT_EQ(xyz.size(), 12u);
-  // 1.0f = 0x3F800000, little-endian: 00 00 80 3F.
-  EXPECT_EQ(static_cast<unsigned char>(xyz[0]), 0x00);
-  EXPECT_EQ(static_cast<unsigned char>(xyz[2]), 0x80);
-  EXPECT_EQ(static_cast<unsigned char>(xyz[3]), 0x3F);
-  // -2.0f = 0xC0000000.
-  EXPECT_EQ(static_cast<unsigned char>(xyz[7]), 0xC0);
-  float z = 0.0f;
-  std::memcpy(&z, xyz.data() + 8, 4);  // this machine is little-endian too
-  EXPECT_EQ(z, 0.5f);
-}
-
 TEST(WireConvertTest, PoseRoundTrips) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
