@@ -3,16 +3,16 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
-#include "clients/cli/bench_command.h"
-#include "clients/cli/cell_command.h"
-#include "clients/cli/eval_command.h"
-#include "clients/cli/health_command.h"
-#include "clients/cli/load_command.h"
-#include "clients/cli/model_command.h"
-#include "clients/cli/params_command.h"
-#include "clients/cli/plan_command.h"
-#include "clients/cli/request_command.h"
-#include "clients/cli/scene_command.h"
+#include "clients/cli/cell/cell_command.h"
+#include "clients/cli/eval/eval_command.h"
+#include "clients/cli/load/load_command.h"
+#include "clients/cli/local/bench_command.h"
+#include "clients/cli/local/model_command.h"
+#include "clients/cli/local/params_command.h"
+#include "clients/cli/local/plan_command.h"
+#include "clients/cli/local/scene_command.h"
+#include "clients/cli/remote/health_command.h"
+#include "clients/cli/remote/request_command.h"
 #include "core/common/errors.h"
 
 int main(int argc, char** argv) {

@@ -9,6 +9,7 @@ find_package(CLI11 REQUIRED)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
 find_package(Protobuf REQUIRED)
 find_package(gRPC CONFIG REQUIRED)
+find_package(CURL REQUIRED)
 if(TUBEPICK_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
@@ -16,16 +17,15 @@ if(TUBEPICK_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()
 
-# PCL: only the components core/ uses, wrapped in one interface target with SYSTEM includes.
-# Debian's VTK (pulled in by PCLConfig) links MPI::MPI_C; define it first.
+# PCL: only the components core/ uses (pcl/point_cloud.h and pcl/kdtree/kdtree_flann.h in
+# core/modeling/filter_outliers.cc; every other stage is our own code), wrapped in one interface
+# target with SYSTEM includes. Debian's VTK (pulled in by PCLConfig) links MPI::MPI_C; define it first.
 find_package(MPI QUIET COMPONENTS C)
-find_package(PCL 1.12 REQUIRED COMPONENTS common kdtree search features filters segmentation sample_consensus)
+find_package(PCL 1.12 REQUIRED COMPONENTS common kdtree)
 add_library(tubepick_pcl INTERFACE)
 target_include_directories(tubepick_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
 # Only the component libraries (PCL_LIBRARIES also drags in VTK, which core never uses).
-target_link_libraries(tubepick_pcl INTERFACE
-  ${PCL_COMMON_LIBRARIES} ${PCL_KDTREE_LIBRARIES} ${PCL_SEARCH_LIBRARIES} ${PCL_FEATURES_LIBRARIES}
-  ${PCL_FILTERS_LIBRARIES} ${PCL_SEGMENTATION_LIBRARIES} ${PCL_SAMPLE_CONSENSUS_LIBRARIES} FLANN::FLANN)
+target_link_libraries(tubepick_pcl INTERFACE ${PCL_COMMON_LIBRARIES} ${PCL_KDTREE_LIBRARIES} FLANN::FLANN)
 target_compile_definitions(tubepick_pcl INTERFACE ${PCL_DEFINITIONS})
 
 # Bullet in double precision everywhere (Debian's BulletConfig-float64.cmake): the definition is

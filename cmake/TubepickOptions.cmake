@@ -14,3 +14,11 @@ function(tubepick_add_test name)
   gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST
     WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR} PROPERTIES TIMEOUT 600)
 endfunction()
+
+# ccache, when installed (deploy/install-deps.sh installs it), makes rebuilds of unchanged sources
+# cheap for developers and for CI runs on a machine that built before. -DCMAKE_CXX_COMPILER_LAUNCHER=
+# (empty) turns it off.
+find_program(TUBEPICK_CCACHE ccache)
+if(TUBEPICK_CCACHE AND NOT DEFINED CMAKE_CXX_COMPILER_LAUNCHER)
+  set(CMAKE_CXX_COMPILER_LAUNCHER ${TUBEPICK_CCACHE})
+endif()

@@ -23,19 +23,18 @@ if [ "$mode" = runtime ]; then
   packages=(
     ca-certificates
     libgrpc++1.51 libprotobuf32
-    libpcl-common1.13 libpcl-features1.13 libpcl-filters1.13 libpcl-kdtree1.13 libpcl-ml1.13
-    libpcl-octree1.13 libpcl-sample-consensus1.13 libpcl-search1.13 libpcl-segmentation1.13
+    libpcl-common1.13 libpcl-kdtree1.13
     libbullet3.24
-    libspdlog1.10 libfmt9 libyaml-cpp0.7 libmodbus5 libgomp1 libssl3
+    libspdlog1.10 libfmt9 libyaml-cpp0.7 libmodbus5 libcurl4 libgomp1 libssl3
   )
 else
   packages=(
-    build-essential cmake ninja-build pkg-config git ca-certificates
+    build-essential cmake ninja-build ccache pkg-config git ca-certificates
     clang-format
     libeigen3-dev libpcl-dev libbullet-dev libbullet-extras-dev
     libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
     libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
-    libmodbus-dev libgtest-dev libgmock-dev libbenchmark-dev
+    libmodbus-dev libcurl4-openssl-dev libgtest-dev libgmock-dev libbenchmark-dev
     openssl curl
   )
 fi

@@ -9,11 +9,11 @@
 #include <utility>
 
 #include "core/common/errors.h"
-#include "proto/grpc_status_name.h"
-#include "server/cloud_stream.h"
 #include "server/planning_jobs.h"
 #include "server/request_log.h"
 #include "server/request_validation.h"
+#include "wire/cloud_stream.h"
+#include "wire/status_names.h"
 
 namespace tubepick::server {
 namespace {

@@ -9,7 +9,7 @@
 #include "core/wrench/held_count.h"
 #include "core/wrench/resolution_rotation.h"
 #include "physics/trajectory_simulator.h"
-#include "server/proto_convert.h"
+#include "wire/response_convert.h"
 
 namespace tubepick::server {
 namespace {

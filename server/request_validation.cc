@@ -7,8 +7,8 @@
 #include <cstring>
 
 #include "core/common/errors.h"
-#include "core/common/packed_cloud.h"
-#include "server/proto_convert.h"
+#include "wire/packed_cloud.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::server {
 namespace {
@@ -22,8 +22,6 @@ constexpr double kMaxTubeRadius = 0.2;
 constexpr double kMaxTubeLength = 10.0;  // m
 constexpr double kMinTubeMass = 0.001;   // kg
 constexpr double kMaxTubeMass = 50.0;
-// Largest |‖q‖ − 1| of a quaternion accepted (and then normalised).
-constexpr double kQuaternionTol = 1e-3;
 
 std::string Num(double value) {
   char buffer[40];
@@ -50,36 +48,6 @@ void RequireRange(double value, double lo, double hi, bool lo_open, const std::s
     throw InvalidArgument(field + ": " + Num(value) + " " + unit + " is out of range " +
                           (lo_open ? "(" : "[") + Num(lo) + ", " + Num(hi) + "] " + unit);
   }
-}
-
-Eigen::Vector3d ToVector(const v1::Vector3& v, const std::string& field) {
-  RequireFiniteField(v.x(), field + ".x");
-  RequireFiniteField(v.y(), field + ".y");
-  RequireFiniteField(v.z(), field + ".z");
-  return {v.x(), v.y(), v.z()};
-}
-
-// A unit quaternion within kQuaternionTol, normalised; a zero or far-from-unit quaternion is an error.
-Eigen::Quaterniond ToRotation(const v1::Quaternion& q, const std::string& field) {
-  RequireFiniteField(q.x(), field + ".x");
-  RequireFiniteField(q.y(), field + ".y");
-  RequireFiniteField(q.z(), field + ".z");
-  RequireFiniteField(q.w(), field + ".w");
-  const Eigen::Quaterniond rotation(q.w(), q.x(), q.y(), q.z());
-  const double norm = rotation.norm();
-  if (!(std::abs(norm - 1.0) <= kQuaternionTol)) {
-    throw InvalidArgument(field + ": quaternion (x, y, z, w) = (" + Num(q.x()) + ", " + Num(q.y()) + ", " +
-                          Num(q.z()) + ", " + Num(q.w()) + ") is not unit length: |q| = " + Num(norm) +
-                          " (tolerance 1e-3)" + (norm == 0.0 ? "; an absent orientation is all zeros" : ""));
-  }
-  return rotation.normalized();
-}
-
-Eigen::Isometry3d ToPose(const v1::Pose& pose, const std::string& field) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.translation() = ToVector(pose.position(), field + ".position");
-  X.linear() = ToRotation(pose.orientation(), field + ".orientation").toRotationMatrix();
-  return X;
 }
 
 std::string KnownProfiles(const PlanningDefaults& defaults) {
@@ -179,7 +147,7 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
 
   if (!cell->has_bin_inner_size())
     throw InvalidArgument(f + "bin_inner_size: required when the cell is given");
-  const Eigen::Vector3d size = ToVector(cell->bin_inner_size(), f + "bin_inner_size");
+  const Eigen::Vector3d size = FromProto(cell->bin_inner_size(), f + "bin_inner_size");
   static const char* const kAxes[] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
     RequireRange(size[i], kMinBinSize, kMaxBinSize, false, f + "bin_inner_size." + kAxes[i], "m");
@@ -187,7 +155,7 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   out.bin.inner_size = size;
 
   if (!cell->has_sensor_pose()) throw InvalidArgument(f + "sensor_pose: required when the cell is given");
-  out.sensor.X_BinSensor = ToPose(cell->sensor_pose(), f + "sensor_pose");
+  out.sensor.X_BinSensor = FromProto(cell->sensor_pose(), f + "sensor_pose");
   if (!(out.sensor.X_BinSensor.translation().z() > 0.0)) {
     throw InvalidArgument(f + "sensor_pose.position.z: the sensor must be above the bin floor (z > 0), got " +
                           Num(out.sensor.X_BinSensor.translation().z()) + " m");
@@ -201,7 +169,7 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   out.tube.mass = cell->tube_mass();
 
   if (!cell->has_place_pose()) throw InvalidArgument(f + "place_pose: required when the cell is given");
-  out.place.X_BinPlace = ToPose(cell->place_pose(), f + "place_pose");
+  out.place.X_BinPlace = FromProto(cell->place_pose(), f + "place_pose");
 
   try {
     out.Validate();  // the same limits; a safety net should they ever drift apart
@@ -243,16 +211,16 @@ WrenchJob ValidateAnalyzeWrench(const v1::AnalyzeWrenchRequest& request, const P
     throw InvalidArgument("reference: required (the F/T reading with the gripper empty, before the pick)");
   }
   if (!request.has_current()) throw InvalidArgument("current: required (the F/T reading after the lift)");
-  job.reference.force = ToVector(request.reference().force(), "reference.force");
-  job.reference.torque = ToVector(request.reference().torque(), "reference.torque");
-  job.current.force = ToVector(request.current().force(), "current.force");
-  job.current.torque = ToVector(request.current().torque(), "current.torque");
+  job.reference.force = FromProto(request.reference().force(), "reference.force");
+  job.reference.torque = FromProto(request.reference().torque(), "reference.torque");
+  job.current.force = FromProto(request.current().force(), "current.force");
+  job.current.torque = FromProto(request.current().torque(), "current.torque");
 
   job.tube_mass = request.has_tube_mass() ? request.tube_mass() : defaults.cell.tube.mass;
   RequireRange(job.tube_mass, kMinTubeMass, kMaxTubeMass, false, "tube_mass", "kg");
 
   if (!request.has_tcp_pose()) throw InvalidArgument("tcp_pose: required (X_BinTcp at lift time)");
-  job.X_BinTcp = ToPose(request.tcp_pose(), "tcp_pose");
+  job.X_BinTcp = FromProto(request.tcp_pose(), "tcp_pose");
 
   job.params = ProfileOf(defaults, defaults.profile, "planning.profile").wrench;
   if (request.variant() != v1::RESOLUTION_VARIANT_UNSPECIFIED) {  // else the profile's

@@ -9,7 +9,7 @@
 #include "clients/cell/cell_records.h"
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
-#include "clients/cell/sim_round.h"
+#include "clients/cli/cell/sim_round.h"
 #include "devices/sim/sim_cell.h"
 #include "physics/tube_geometry.h"
 #include "server/planner_server.h"
@@ -45,7 +45,7 @@ TEST_F(CellEndToEndTest, ThreePvcTubesAreAllPickedAndPlaced) {
   const devices::sim::SimCellParams sim =
       devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 3, 7);
 
-  const cell::SimRoundResult r = cell::RunSimRound(planner, sim, params, 0, &sink);
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, params, 0, &sink);
 
   EXPECT_EQ(r.run.reason, cell::CellStopReason::kBinEmpty) << r.run.message;
   EXPECT_EQ(r.tubes_in_bin, 0u);
@@ -109,7 +109,7 @@ TEST_F(CellEndToEndTest, TubeAlongALongWallIsNudgedOffItAndPicked) {
   cell::CellControllerParams params;
   params.seed = 11;
 
-  const cell::SimRoundResult result = cell::RunSimRound(planner, sim, params, 0, &sink);
+  const cli::SimRoundResult result = cli::RunSimRound(planner, sim, params, 0, &sink);
 
   EXPECT_EQ(result.run.reason, cell::CellStopReason::kBinEmpty) << result.run.message;
   EXPECT_EQ(result.tubes_in_bin, 0u);
@@ -141,7 +141,7 @@ TEST_F(CellEndToEndTest, ServerGoneMidRoundEndsInSafeStopWithTheGripperOpen) {
   cell::GrpcPlannerClient planner(address(), options);
   server_->Shutdown(std::chrono::milliseconds(0));
   cell::MemoryRecordSink sink;
-  const cell::SimRoundResult r = cell::RunSimRound(
+  const cli::SimRoundResult r = cli::RunSimRound(
       planner, devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3), {}, 0, &sink);
   EXPECT_EQ(r.run.reason, cell::CellStopReason::kFault);
   ASSERT_TRUE(r.run.fault);

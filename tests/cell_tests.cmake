@@ -1,8 +1,8 @@
 # The cell controller end to end (unit tests of the state machine: clients/cell/test):
 # - cell_e2e_test: a real in-process PlannerServer, the gRPC client and the simulated cell;
 # - cell_cli_test: `tubepick cell --sim` starting tubepick-server itself (--server auto).
-if(TARGET tubepick_cell AND TARGET tubepick_devices_sim)
-  tubepick_add_test(cell_e2e_test SOURCES cell_e2e_test.cc LIBS tubepick_cell tubepick_server)
+if(TARGET tubepick_cli_cell)
+  tubepick_add_test(cell_e2e_test SOURCES cell_e2e_test.cc LIBS tubepick_cli_cell tubepick_server)
   target_include_directories(cell_e2e_test PRIVATE ${PROJECT_SOURCE_DIR})
 endif()
 if(TARGET tubepick-server)

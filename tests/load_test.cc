@@ -1,6 +1,6 @@
-// The load tool (clients/cli/load_engine.h) and the health check (health_command.h) against a real
-// PlannerServer in-process on loopback: counts, percentile order, errors counted by status code, RSS
-// sampling from the real metrics endpoint.
+// The load tool (clients/cli/load/load_engine.h) and the health check (clients/cli/remote/health_command.h)
+// against a real PlannerServer in-process on loopback: counts, percentile order, errors counted by status
+// code, RSS sampling from the real metrics endpoint. The load room's pure logic: clients/cli/load/test/.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -9,20 +9,18 @@
 #include <fstream>
 #include <memory>
 
-#include "clients/cli/builtin_scene.h"
-#include "clients/cli/health_command.h"
-#include "clients/cli/load_engine.h"
-#include "clients/cli/load_metrics.h"
+#include "clients/cli/inputs/builtin_scene.h"
+#include "clients/cli/load/load_engine.h"
+#include "clients/cli/load/load_metrics.h"
+#include "clients/cli/remote/health_command.h"
 #include "core/common/errors.h"
-#include "core/common/packed_cloud.h"
 #include "core/modeling/cloud_io.h"
 #include "server/planner_server.h"
 #include "server/server_config.h"
+#include "wire/packed_cloud.h"
 
 namespace tubepick::cli {
 namespace {
-
-constexpr double kTol = 1e-12;
 
 /// Loopback server: gRPC and metrics on free ports, `workers` workers, queue `queue`.
 class LocalServer {
@@ -71,85 +69,6 @@ void ExpectOrdered(const LatencySummary& l) {
   EXPECT_LE(l.p99, l.max);
   EXPECT_GE(l.mean, l.min);
   EXPECT_LE(l.mean, l.max);
-}
-
-TEST(LoadEngine, SummarizeLatencyNearestRank) {
-  std::vector<double> seconds;
-  for (int i = 100; i >= 1; --i) seconds.push_back(i / 100.0);  // 0.01 .. 1.00, reversed
-  const LatencySummary s = SummarizeLatency(seconds);
-  EXPECT_NEAR(s.min, 0.01, kTol);
-  EXPECT_NEAR(s.p50, 0.50, kTol);
-  EXPECT_NEAR(s.p90, 0.90, kTol);
-  EXPECT_NEAR(s.p95, 0.95, kTol);
-  EXPECT_NEAR(s.p99, 0.99, kTol);
-  EXPECT_NEAR(s.max, 1.00, kTol);
-  EXPECT_NEAR(s.mean, 0.505, kTol);
-  const LatencySummary one = SummarizeLatency({0.3});
-  EXPECT_EQ(one.p50, 0.3);
-  EXPECT_EQ(one.p99, 0.3);
-  EXPECT_EQ(SummarizeLatency({}).max, 0.0);
-}
-
-TEST(LoadEngine, ReadLoadCloudsFindsPlyAndPcdRecursivelySorted) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tubepick_load_clouds_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir / "scene-2");
-  std::filesystem::create_directories(dir / "scene-1");
-  WritePly((dir / "scene-2" / "cloud.ply").string(), Points(5, Eigen::Vector3f(0.1f, 0.2f, 1.0f)));
-  WritePcd((dir / "scene-1" / "cloud.pcd").string(), Points(3, Eigen::Vector3f(0.1f, 0.2f, 1.0f)), true);
-  std::ofstream((dir / "notes.txt").string()) << "not a cloud\n";
-
-  const std::vector<LoadCloud> clouds = ReadLoadClouds(dir.string(), v1::LENGTH_UNIT_MILLIMETRE);
-  ASSERT_EQ(clouds.size(), 2u);
-  EXPECT_NE(clouds[0].name.find("scene-1"), std::string::npos);
-  EXPECT_EQ(clouds[0].xyz.size(), 3u * 12u);
-  EXPECT_EQ(clouds[1].xyz.size(), 5u * 12u);
-  EXPECT_EQ(clouds[1].unit, v1::LENGTH_UNIT_MILLIMETRE);
-  std::filesystem::remove_all(dir);
-
-  std::filesystem::create_directories(dir);
-  try {
-    ReadLoadClouds(dir.string(), v1::LENGTH_UNIT_UNSPECIFIED);
-    FAIL() << "an empty directory must throw";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("no .ply or .pcd"), std::string::npos) << e.what();
-  }
-  std::filesystem::remove_all(dir);
-}
-
-TEST(LoadMetrics, PrometheusSampleMatchesNameAndLabels) {
-  const std::string text =
-      "# HELP process_resident_memory_bytes Resident memory.\n"
-      "# TYPE process_resident_memory_bytes gauge\n"
-      "process_resident_memory_bytes_total_bogus 1\n"
-      "process_resident_memory_bytes 123456789\n"
-      "tubepick_rpc_calls_total{method=\"PlanPick\",code=\"OK\"} 4\n"
-      "tubepick_rpc_calls_total{method=\"ModelTubes\",code=\"OK\"} 7\n";
-  EXPECT_EQ(PrometheusSample(text, "process_resident_memory_bytes"), 123456789.0);
-  EXPECT_EQ(PrometheusSample(text, "tubepick_rpc_calls_total", "method=\"ModelTubes\""), 7.0);
-  EXPECT_EQ(PrometheusSample(text, "tubepick_rpc_calls_total"), 4.0);
-  EXPECT_FALSE(PrometheusSample(text, "process_virtual_memory_bytes").has_value());
-}
-
-TEST(LoadMetrics, SummarizeRssComparesFirstAndLastMinute) {
-  // 10 minutes, one sample every 30 s: 100 MB in the first minute, 104 MB peak mid-run, 105 MB
-  // in the last minute.
-  std::vector<RssSample> samples;
-  for (int i = 0; i <= 20; ++i) {
-    std::uint64_t mb = i <= 2 ? 100 : (i >= 18 ? 105 : 104);
-    if (i == 10) mb = 120;
-    samples.push_back({30.0 * i, mb * 1'000'000});
-  }
-  const RssSummary s = SummarizeRss(samples, 60.0);
-  EXPECT_EQ(s.first_window_max, 100'000'000u);
-  EXPECT_EQ(s.last_window_max, 105'000'000u);
-  EXPECT_EQ(s.peak, 120'000'000u);
-  EXPECT_NEAR(s.growth_percent, 5.0, 1e-9);
-}
-
-TEST(LoadMetrics, HttpGetOfAClosedPortThrows) {
-  EXPECT_THROW(HttpGet("http://127.0.0.1:1/metrics", std::chrono::seconds(2)), std::runtime_error);
-  EXPECT_THROW(HttpGet("https://127.0.0.1:1/metrics", std::chrono::seconds(2)), std::runtime_error);
 }
 
 TEST(LoadAgainstServer, CountsOkAndInvalidArgumentRoundRobin) {

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 
-#include "server/cloud_stream.h"
 #include "tests/service_test_support.h"
+#include "wire/cloud_stream.h"
 
 namespace tubepick::service_test {
 namespace {
@@ -15,19 +15,7 @@ using ::testing::HasSubstr;
 
 /// The messages of one stream: header first, then the chunks in index order.
 std::vector<v1::PlanPickStreamRequest> StreamMessages(const std::string& xyz, std::size_t chunk_bytes) {
-  std::vector<v1::PlanPickStreamRequest> messages(1);
-  v1::PlanPickStreamHeader* header = messages[0].mutable_header();
-  *header->mutable_request() = PlanRequest("");
-  header->set_total_bytes(xyz.size());
-  header->set_chunk_count(static_cast<std::uint32_t>((xyz.size() + chunk_bytes - 1) / chunk_bytes));
-  header->set_crc32c(server::Crc32c(xyz));
-  for (std::uint32_t i = 0; i * chunk_bytes < xyz.size(); ++i) {
-    v1::PlanPickStreamRequest m;
-    m.mutable_chunk()->set_index(i);
-    m.mutable_chunk()->set_data(xyz.substr(i * chunk_bytes, chunk_bytes));
-    messages.push_back(std::move(m));
-  }
-  return messages;
+  return SplitCloudStream(PlanRequest(""), xyz, chunk_bytes);
 }
 
 struct StreamResult {

@@ -15,11 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/common/packed_cloud.h"
 #include "core/params.h"
 #include "core/testing/synthetic_cloud.h"
 #include "physics/scene_generator.h"
 #include "physics/virtual_scanner.h"
+#include "wire/packed_cloud.h"
 
 namespace tubepick::service_test {
 namespace {

@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "clients/cell/wire_convert.h"
+#include "wire/proto_convert.h"
 #include "core/common/errors.h"
-#include "core/common/packed_cloud.h"
+#include "wire/packed_cloud.h"
 
 namespace tubepick::cell {
 namespace {
@@ -18,7 +18,7 @@ using Clock = std::chrono::steady_clock;
 
 /// The plan's unit approach direction; the TCP's z axis when the plan gives none.
 Eigen::Vector3d ApproachOf(const v1::PickPlan& plan, const Eigen::Isometry3d& X_grasp) {
-  Eigen::Vector3d approach = FromWire(plan.grasp().approach());
+  Eigen::Vector3d approach = FromProto(plan.grasp().approach());
   if (!approach.allFinite() || approach.norm() < 1e-9) approach = X_grasp.linear().col(2);
   return approach.normalized();
 }
@@ -233,10 +233,10 @@ v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& 
                                                   const devices::WrenchReading& current,
                                                   const Eigen::Isometry3d& X_lift, Attempt& attempt) {
   v1::AnalyzeWrenchRequest request;
-  *request.mutable_reference() = ToWire(reference);
-  *request.mutable_current() = ToWire(current);
+  *request.mutable_reference() = ToProto(Wrench{reference.force, reference.torque});
+  *request.mutable_current() = ToProto(Wrench{current.force, current.torque});
   request.set_tube_mass(cell_.tube.mass);
-  *request.mutable_tcp_pose() = ToWire(X_lift);
+  *request.mutable_tcp_pose() = ToProto(X_lift);
   request.set_variant(params_.resolution_variant);
   const Clock::time_point start = Clock::now();
   v1::AnalyzeWrenchResponse response =
@@ -252,12 +252,12 @@ v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& 
 std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& plan, int rank) const {
   Eigen::Isometry3d X_grasp;
   try {
-    X_grasp = FromWire(plan.grasp().tcp_pose(), fmt::format("plans[{}].grasp.tcp_pose", rank));
+    X_grasp = FromProto(plan.grasp().tcp_pose(), fmt::format("plans[{}].grasp.tcp_pose", rank));
   } catch (const InvalidArgument& e) {
     throw CellFault("planner", FaultKind::kServerError, ToString(state_), e.what());
   }
   std::vector<Eigen::Vector3d> waypoints;
-  for (const v1::Vector3& w : plan.waypoints()) waypoints.push_back(FromWire(w));
+  for (const v1::Vector3& w : plan.waypoints()) waypoints.push_back(FromProto(w));
   // The arm's reach and wrist limits: pre-grasp, grasp, every lift waypoint and the placement.
   const devices::RobotLimits limits = devices_.robot->Limits();
   std::vector<std::pair<std::string, Eigen::Isometry3d>> poses;
@@ -271,7 +271,7 @@ std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& 
   if (plan.has_place_tcp_pose()) {
     try {
       poses.emplace_back("place",
-                         FromWire(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank)));
+                         FromProto(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank)));
     } catch (const InvalidArgument& e) {
       throw CellFault("planner", FaultKind::kServerError, ToString(state_), e.what());
     }
@@ -311,8 +311,8 @@ void CellController::ExecutePlan(const v1::PlanPickResponse& response, int plan_
   const std::string field = fmt::format("plans[{}]", plan_index);
   Eigen::Isometry3d X_grasp, X_place;
   try {
-    X_grasp = FromWire(plan.grasp().tcp_pose(), field + ".grasp.tcp_pose");
-    X_place = FromWire(plan.place_tcp_pose(), field + ".place_tcp_pose");
+    X_grasp = FromProto(plan.grasp().tcp_pose(), field + ".grasp.tcp_pose");
+    X_place = FromProto(plan.place_tcp_pose(), field + ".place_tcp_pose");
   } catch (const InvalidArgument& e) {
     throw CellFault("planner", FaultKind::kServerError, ToString(CellState::kPlan), e.what());
   }
@@ -360,7 +360,7 @@ void CellController::ExecutePlan(const v1::PlanPickResponse& response, int plan_
   // Lift along the plan's trajectory.
   Enter(CellState::kLift);
   std::vector<Eigen::Vector3d> waypoints;
-  for (const v1::Vector3& w : plan.waypoints()) waypoints.push_back(FromWire(w));
+  for (const v1::Vector3& w : plan.waypoints()) waypoints.push_back(FromProto(w));
   MoveThrough(waypoints, params_.lift_speed, &attempt);
   const Eigen::Isometry3d X_lift = CurrentPose();
 
@@ -401,7 +401,7 @@ void CellController::ExecutePlan(const v1::PlanPickResponse& response, int plan_
     for (int w = 0; w < motion.waypoints_size(); ++w) {
       Eigen::Isometry3d X_wp;
       try {
-        X_wp = FromWire(motion.waypoints(w).tcp_pose(),
+        X_wp = FromProto(motion.waypoints(w).tcp_pose(),
                         fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w));
       } catch (const InvalidArgument& e) {
         throw CellFault("planner", FaultKind::kServerError, ToString(state_), e.what());
@@ -565,7 +565,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
         Enter(CellState::kPlan);
         v1::PlanPickRequest request;
         *request.mutable_cloud()->mutable_xyz() = PackXyz(capture.points_Sensor);
-        request.mutable_cloud()->set_unit(ToWire(capture.unit));
+        request.mutable_cloud()->set_unit(ToProto(capture.unit));
         *request.mutable_cell() = ToCellDescription(cell_, capture.X_BinSensor);
         request.mutable_options()->set_profile(params_.profile);
         request.mutable_options()->set_seed(params_.seed + scan);

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "clients/cell/wire_convert.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::cell {
 namespace {
@@ -42,12 +42,12 @@ Walls WallDistances(const Eigen::Vector3d& p, const CellConfig& cell) {
 
 std::vector<Sample> SampleTube(const v1::Tube& tube, double spacing, double default_radius) {
   double total = 0.0;
-  for (const v1::Cylinder& c : tube.cylinders()) total += (FromWire(c.end()) - FromWire(c.start())).norm();
+  for (const v1::Cylinder& c : tube.cylinders()) total += (FromProto(c.end()) - FromProto(c.start())).norm();
   std::vector<Sample> samples;
   if (!(total > 0.0)) return samples;
   double offset = 0.0;
   for (const v1::Cylinder& c : tube.cylinders()) {
-    const Eigen::Vector3d a = FromWire(c.start()), b = FromWire(c.end());
+    const Eigen::Vector3d a = FromProto(c.start()), b = FromProto(c.end());
     const double length = (b - a).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(length / spacing)));
     const double radius = c.radius() > 0.0 ? c.radius() : default_radius;

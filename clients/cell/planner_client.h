@@ -8,7 +8,7 @@
 
 #include <grpcpp/support/status.h>
 
-#include "proto/grpc_status_name.h"
+#include "wire/status_names.h"
 #include "tubepick/v1/planning.pb.h"
 #include "tubepick/v1/requests.pb.h"
 #include "tubepick/v1/wrench.pb.h"

@@ -6,7 +6,7 @@
 #include <chrono>
 #include <string>
 
-#include "devices/rdt_fake.h"
+#include "devices/testing/rdt_fake.h"
 
 namespace tubepick::devices {
 namespace {

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <string>
 
-#include "devices/robotiq_fake.h"
+#include "devices/testing/robotiq_fake.h"
 
 namespace tubepick::devices {
 namespace {

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <string>
 
-#include "devices/hses_fake.h"
+#include "devices/testing/hses_fake.h"
 
 namespace tubepick::devices {
 namespace {

@@ -1,23 +1,9 @@
 #pragma once
 
-#include <gtest/gtest.h>
-
-#include <string>
-
-#include "core/common/errors.h"
+#include "core/testing/error_of.h"
 
 namespace tubepick::server {
 
-/// Runs `f` and returns the InvalidArgument message (fails the test when nothing is thrown).
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InvalidArgument";
-  return "";
-}
+using tubepick::testing::ErrorOf;
 
 }  // namespace tubepick::server

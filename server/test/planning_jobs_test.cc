@@ -11,7 +11,7 @@
 
 #include "core/common/errors.h"
 #include "core/testing/synthetic_cloud.h"
-#include "server/proto_convert.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::server {
 namespace {
@@ -309,7 +309,7 @@ v1::AnalyzeWrenchRequest WrenchRequest(double held_tubes, const Eigen::Vector3d&
   r.mutable_current()->mutable_torque()->set_y(delta_torque.y());
   r.mutable_current()->mutable_torque()->set_z(delta_torque.z());
   r.set_tube_mass(kMass);
-  ToProto(GraspTcp(), r.mutable_tcp_pose());
+  *r.mutable_tcp_pose() = ToProto(GraspTcp());
   r.set_variant(variant);
   return r;
 }

@@ -52,7 +52,7 @@ class CellControllerTest : public ::testing::Test {
 
   /// Waypoint `X` added to motion `m` of `response`.
   static void AddWaypoint(v1::AnalyzeWrenchResponse& response, int m, const Eigen::Isometry3d& X) {
-    *response.mutable_resolution_motions(m)->add_waypoints()->mutable_tcp_pose() = ToWire(X);
+    *response.mutable_resolution_motions(m)->add_waypoints()->mutable_tcp_pose() = ToProto(X);
   }
 
   testing::ScriptedScanner scanner;
@@ -366,8 +366,8 @@ testing::ScriptedPlanner::PlanAnswer WallTubeWithoutPlan() {
   tube->set_id(0);
   tube->set_occlusion(v1::OCCLUSION_NONE);
   v1::Cylinder* c = tube->add_cylinders();
-  *c->mutable_start() = ToWire(Eigen::Vector3d(-0.2, -0.27, 0.0125));
-  *c->mutable_end() = ToWire(Eigen::Vector3d(0.2, -0.27, 0.0125));
+  *c->mutable_start() = ToProto(Eigen::Vector3d(-0.2, -0.27, 0.0125));
+  *c->mutable_end() = ToProto(Eigen::Vector3d(0.2, -0.27, 0.0125));
   c->set_radius(0.0125);
   return a;
 }

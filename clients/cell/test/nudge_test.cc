@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "clients/cell/wire_convert.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::cell {
 namespace {
@@ -17,8 +17,8 @@ v1::Tube StraightTube(std::uint32_t id, const Eigen::Vector3d& a, const Eigen::V
   tube.set_id(id);
   tube.set_occlusion(occlusion);
   v1::Cylinder* c = tube.add_cylinders();
-  *c->mutable_start() = ToWire(a);
-  *c->mutable_end() = ToWire(b);
+  *c->mutable_start() = ToProto(a);
+  *c->mutable_end() = ToProto(b);
   c->set_radius(kR);
   return tube;
 }

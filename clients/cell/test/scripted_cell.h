@@ -12,7 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "clients/cell/planner_client.h"
-#include "clients/cell/wire_convert.h"
+#include "wire/proto_convert.h"
 #include "devices/force_torque_sensor.h"
 #include "devices/gripper.h"
 #include "devices/robot.h"
@@ -208,13 +208,13 @@ inline v1::PickPlan MakePlan(std::uint32_t tube, const Eigen::Vector3d& p_grasp,
                                                                        Eigen::Vector3d(0, 0, 0.4)}) {
   v1::PickPlan plan;
   plan.set_tube_id(tube);
-  *plan.mutable_grasp()->mutable_tcp_pose() = ToWire(DownPose(p_grasp));
-  *plan.mutable_grasp()->mutable_approach() = ToWire(Eigen::Vector3d(0, 0, -1));
+  *plan.mutable_grasp()->mutable_tcp_pose() = ToProto(DownPose(p_grasp));
+  *plan.mutable_grasp()->mutable_approach() = ToProto(Eigen::Vector3d(0, 0, -1));
   plan.mutable_grasp()->set_opening_width(0.045);
-  for (const Eigen::Vector3d& w : waypoints) *plan.add_waypoints() = ToWire(w);
+  for (const Eigen::Vector3d& w : waypoints) *plan.add_waypoints() = ToProto(w);
   plan.set_trajectory_kind(kind);
   plan.mutable_cost()->set_total(0.1 * tube);
-  *plan.mutable_place_tcp_pose() = ToWire(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12)));
+  *plan.mutable_place_tcp_pose() = ToProto(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12)));
   return plan;
 }
 

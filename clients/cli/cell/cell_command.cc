@@ -1,0 +1,232 @@
+#include "clients/cli/cell/cell_command.h"
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <memory>
+
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_controller_config.h"
+#include "clients/cell/cell_records.h"
+#include "clients/cell/cell_statistics.h"
+#include "clients/cell/planner_client.h"
+#include "clients/cli/cell/cell_tables.h"
+#include "clients/cli/cell/server_process.h"
+#include "clients/cli/cell/sim_round.h"
+#include "core/common/cell_config.h"
+#include "core/common/errors.h"
+#include "devices/sim/sim_cell.h"
+
+namespace tubepick::cli {
+namespace {
+
+using nlohmann::json;
+
+struct CellOptions {
+  bool sim = false;
+  std::uint32_t rounds = 1;
+  std::uint32_t tubes = 7;
+  std::string material = "pvc";
+  std::string server = "auto";
+  std::uint64_t seed = 1;
+  std::string records_path;
+  std::string json_path;
+  std::string profile;
+  std::string resolution;
+  bool no_sim_planning = false;
+  double plan_deadline = 300.0;
+  std::uint32_t max_attempts_per_tube = 0;
+  std::string controller_path;  ///< empty = the controller's defaults
+  bool print_controller_config = false;
+  std::string cell_path;  ///< empty = the thesis cell for --material
+  // Options given on the command line (they override --controller).
+  bool profile_given = false;
+  bool resolution_given = false;
+  bool plan_deadline_given = false;
+};
+
+v1::ResolutionVariant ParseVariant(const std::string& name) {
+  if (name.empty()) return v1::RESOLUTION_VARIANT_UNSPECIFIED;
+  if (name == "torque_axis") return v1::RESOLUTION_VARIANT_TORQUE_AXIS;
+  if (name == "torque_axis_negative") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE;
+  if (name == "perpendicular") return v1::RESOLUTION_VARIANT_PERPENDICULAR;
+  if (name == "joint_safe") return v1::RESOLUTION_VARIANT_JOINT_SAFE;
+  throw InvalidArgument(
+      fmt::format("--resolution: unknown variant \"{}\" (torque_axis, torque_axis_negative, "
+                  "perpendicular, joint_safe)",
+                  name));
+}
+
+/// The controller parameters of every round but the seed: --controller (or the defaults), then the
+/// options given on the command line. Without --controller, --plan-deadline applies with its default
+/// (300 s) as before.
+cell::CellControllerParams ControllerParams(const CellOptions& o) {
+  cell::CellControllerParams params = o.controller_path.empty()
+                                          ? cell::CellControllerParams{}
+                                          : cell::LoadCellControllerParams(o.controller_path);
+  if (o.profile_given) params.profile = o.profile;
+  if (o.resolution_given) params.resolution_variant = ParseVariant(o.resolution);
+  if (o.no_sim_planning) params.disable_simulation = true;
+  if (o.controller_path.empty() || o.plan_deadline_given) {
+    if (!(o.plan_deadline > 0.0))
+      throw InvalidArgument(fmt::format("--plan-deadline: must be positive, got {}", o.plan_deadline));
+    params.plan_deadline = std::chrono::milliseconds(std::llround(o.plan_deadline * 1000.0));
+  }
+  if (o.max_attempts_per_tube > 0) params.max_attempts_per_tube = o.max_attempts_per_tube;
+  params.Validate();
+  return params;
+}
+
+void Run(const CellOptions& o) {
+  const cell::CellControllerParams base_params = ControllerParams(o);
+  if (o.print_controller_config) {
+    fmt::print("{}", cell::DumpCellControllerParams(base_params));
+    return;
+  }
+  const bool custom_cell = !o.cell_path.empty();
+  const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
+  if (!o.sim)
+    throw InvalidArgument(
+        "--sim is required: the cell command drives the simulated cell (the real drivers "
+        "in devices/ are not wired to this command yet)");
+  if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
+  if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
+  const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
+
+  std::unique_ptr<ServerProcess> server;
+  std::string address = o.server;
+  if (o.server == "auto") {
+    server =
+        ServerProcess::Start(SiblingExecutable("tubepick-server"),
+                             {"--address", "127.0.0.1:0", "--metrics-address", "", "--log-level", "info"},
+                             std::chrono::seconds(60));
+    address = server->address();
+    fmt::print("planner: started tubepick-server (pid {}) on {}\n", server->pid(), address);
+  } else {
+    fmt::print("planner: {}\n", address);
+  }
+  cell::GrpcPlannerClient planner(address);
+
+  cell::MemoryRecordSink memory;
+  std::unique_ptr<cell::JsonLinesFileSink> file;
+  if (!o.records_path.empty()) file = std::make_unique<cell::JsonLinesFileSink>(o.records_path);
+  cell::TeeRecordSink sink(&memory, file.get());
+
+  json rounds_json = json::array();
+  bool any_fault = false;
+  for (std::uint32_t round = 0; round < o.rounds; ++round) {
+    cell::CellControllerParams params = base_params;
+    params.seed = (o.seed + round) * 1000;
+    devices::sim::SimCellParams sim_params =
+        devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
+    if (custom_cell) sim_params.cell = cell_config;
+    const SimRoundResult r = RunSimRound(planner, sim_params, params, round, &sink);
+    const cell::CellRunResult& result = r.run;
+    const std::uint32_t left = r.tubes_in_bin;
+    const double wall = r.wall_s;
+    fmt::print(
+        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} attempts, {} scans, {:.0f} s "
+        "simulated, "
+        "{:.0f} s wall\n",
+        round, o.seed + round, result.message, result.picks, left, result.attempts, result.scans,
+        r.simulated_s, wall);
+    std::fflush(stdout);
+    rounds_json.push_back({{"round", round},
+                           {"seed", o.seed + round},
+                           {"reason", cell::ToString(result.reason)},
+                           {"message", result.message},
+                           {"picks", result.picks},
+                           {"tubes_left", left},
+                           {"attempts", result.attempts},
+                           {"scans", result.scans},
+                           {"simulated_s", r.simulated_s},
+                           {"wall_s", wall}});
+    if (result.reason == cell::CellStopReason::kFault) {
+      any_fault = true;
+      if (result.fault && result.fault->kind() == cell::FaultKind::kServerUnavailable) {
+        fmt::print("planner unavailable: the remaining rounds are skipped\n");
+        break;
+      }
+    }
+  }
+
+  const cell::CellStatistics stats = cell::SummarizeRecords(memory.records());
+  fmt::print("\n{}", FormatCellTables(
+                         stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
+                                            stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
+  if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", o.json_path));
+    out << json{{"material", o.material},
+                {"tubes", o.tubes},
+                {"seed", o.seed},
+                {"rounds", rounds_json},
+                {"statistics", cell::StatisticsJson(stats)}}
+               .dump(2)
+        << '\n';
+    fmt::print("wrote {}\n", o.json_path);
+  }
+  if (server) {
+    const int status = server->Stop(std::chrono::seconds(15));
+    spdlog::info("tubepick-server exited with status {}", status);
+  }
+  if (any_fault) throw CLI::RuntimeError(3);
+}
+
+}  // namespace
+
+void AddCellCommand(CLI::App& app) {
+  auto o = std::make_shared<CellOptions>();
+  CLI::App* cmd =
+      app.add_subcommand("cell", "Run bin-picking rounds in the simulated cell (thesis Tables 5.4-5.9)");
+  cmd->add_flag("--sim", o->sim, "Use the simulated cell (Bullet world behind all four devices)");
+  cmd->add_option("--rounds", o->rounds, "Rounds (bins) to run; round r uses seed + r")
+      ->capture_default_str();
+  cmd->add_option("--tubes", o->tubes, "Tubes dropped into the bin per round")->capture_default_str();
+  cmd->add_option("--material", o->material, "pvc (set A) or rubber (set B), thesis Table 5.2")
+      ->capture_default_str();
+  cmd->add_option("--server", o->server,
+                  "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the first round's cell and the planner seeds")
+      ->capture_default_str();
+  cmd->add_option("--records", o->records_path, "Write every attempt as a JSON line to this file");
+  cmd->add_option("--json", o->json_path, "Write the per-round results and the statistics as JSON");
+  CLI::Option* profile = cmd->add_option("--profile", o->profile,
+                                         "Planner parameter profile (fast, thesis; default: the server's)");
+  CLI::Option* resolution =
+      cmd->add_option("--resolution", o->resolution,
+                      "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe "
+                      "(default: the server's)");
+  cmd->add_flag("--no-sim-planning", o->no_sim_planning, "Ask the planner not to simulate trajectories");
+  CLI::Option* plan_deadline =
+      cmd->add_option("--plan-deadline", o->plan_deadline,
+                      "PlanPick deadline per try, seconds (with --controller: only when given)")
+          ->capture_default_str();
+  cmd->add_option("--max-attempts-per-tube", o->max_attempts_per_tube,
+                  "Attempts since the last pick before the round stops (0 = controller default)");
+  cmd->add_option("--controller", o->controller_path,
+                  "Cell controller parameters YAML (deploy/cell-controller.example.yaml; strict: unknown "
+                  "keys are errors). Options given here override it; the planner seed of round r is "
+                  "always (--seed + r)·1000")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--print-controller-config", o->print_controller_config,
+                "Print the controller parameters this command would use (defaults, --controller, the "
+                "options given) as YAML and exit");
+  cmd->add_option("--cell", o->cell_path,
+                  "Cell YAML (bin, sensor, place, tube) for the simulated cell and the planner requests "
+                  "(default: the thesis cell for --material)")
+      ->check(CLI::ExistingFile);
+  cmd->callback([o, profile, resolution, plan_deadline] {
+    o->profile_given = profile->count() > 0;
+    o->resolution_given = resolution->count() > 0;
+    o->plan_deadline_given = plan_deadline->count() > 0;
+    Run(*o);
+  });
+}
+
+}  // namespace tubepick::cli

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <cstdint>
+
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_records.h"
+#include "clients/cell/planner_client.h"
+#include "devices/sim/sim_cell.h"
+
+namespace tubepick::cli {
+
+/// One closed-loop round in the simulated cell.
+struct SimRoundResult {
+  cell::CellRunResult run;
+  /// Ground truth at the end: tubes still in the bin and outside it (placed or lost).
+  std::uint32_t tubes_in_bin = 0;
+  std::uint32_t tubes_outside_bin = 0;
+  /// Simulated seconds of the round and the wall time it took (cell construction included).
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+};
+
+/// Builds a SimCell from `sim_params`, runs the cell controller on it against `planner` until the
+/// bin is empty, a limit or a fault, and returns what happened. The controller sees the cell of
+/// `sim_params` (its tube radius, length and mass go to the planner), measures robot time in
+/// simulated seconds, and its records carry the simulation's ground truth as truth_before /
+/// truth_after / truth: {tubes_in_bin, tubes_outside_bin, held, sim_seconds}.
+SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::SimCellParams& sim_params,
+                           const cell::CellControllerParams& params, std::uint32_t round,
+                           cell::RecordSink* sink);
+
+/// The same on a cell built by the caller (e.g. with explicit tubes: SimCell(params, tubes_Bin));
+/// wall_s then covers only the run.
+SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& sim,
+                           const cell::CellControllerParams& params, std::uint32_t round,
+                           cell::RecordSink* sink);
+
+}  // namespace tubepick::cli

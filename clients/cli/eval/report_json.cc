@@ -1,0 +1,154 @@
+// report.json: everything the markdown shows plus per-scene detail, for scripts.
+#include <nlohmann/json.hpp>
+
+#include "clients/cli/eval/eval_report.h"
+
+namespace tubepick::cli {
+namespace {
+
+using nlohmann::json;
+
+json Optional(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+json Timings(const std::vector<StageTiming>& timings) {
+  json out = json::object();
+  for (const StageTiming& t : timings) out[t.stage] = t.seconds;
+  return out;
+}
+
+json AggregateJson(const EvaluationAggregate& a) {
+  return json{{"tube_count", a.tube_count},
+              {"scenes", a.scenes},
+              {"real_tubes", a.real_tubes},
+              {"segmentation_error", Optional(a.segmentation_error)},
+              {"mean_length", Optional(a.mean_length)},
+              {"stddev_length", Optional(a.stddev_length)},
+              {"virtual_tubes", a.virtual_tubes},
+              {"correct", a.correct},
+              {"partially_correct", a.partially_correct},
+              {"not_correct", a.not_correct},
+              {"hidden", a.hidden},
+              {"total_correct", a.total_correct},
+              {"total_partially_correct", a.total_partially_correct},
+              {"total_not_correct", a.total_not_correct},
+              {"total_hidden", a.total_hidden},
+              {"merged", a.merged},
+              {"missed", a.missed},
+              {"under_covered", a.under_covered},
+              {"correct_fraction", a.correct_fraction},
+              {"correct_fraction_visible", a.correct_fraction_visible},
+              {"scenes_all_correct", a.scenes_all_correct},
+              {"matched_points", a.matched_points},
+              {"real_points", a.real_points},
+              {"labelled_points", a.labelled_points},
+              {"background_points", a.background_points},
+              {"background_null", a.background_null},
+              {"real_null", a.real_null},
+              {"micro_recall", a.micro_recall},
+              {"micro_precision", a.micro_precision},
+              {"accuracy", a.accuracy},
+              {"mean_timings", Timings(a.mean_timings)},
+              {"mean_total_seconds", a.mean_total_seconds},
+              {"max_total_seconds", a.max_total_seconds}};
+}
+
+json SceneJson(const EvaluatedScene& s) {
+  const SceneEvaluation& e = s.evaluation;
+  json real = json::array();
+  for (std::size_t j = 0; j < e.real_tubes.size(); ++j) {
+    const RealTubeEvaluation& r = e.real_tubes[j];
+    real.push_back({{"index", j},
+                    {"visible_points", r.visible_points},
+                    {"sections", r.sections},
+                    {"verdict", ToString(r.verdict)},
+                    {"failure", ToString(r.failure)},
+                    {"touching", r.touching},
+                    {"coverage", r.coverage},
+                    {"matched_virtual", r.matched_virtual}});
+  }
+  json virt = json::array();
+  for (const VirtualTubeEvaluation& v : e.virtual_tubes) {
+    virt.push_back({{"id", v.id},
+                    {"length", v.length},
+                    {"cylinders", v.cylinders},
+                    {"points", v.points},
+                    {"majority", v.majority},
+                    {"purity", v.purity},
+                    {"stray_cylinders", v.stray_cylinders},
+                    {"pure", v.pure},
+                    {"matched_real", v.matched_real}});
+  }
+  const ConfusionMatrix& cm = e.confusion;
+  json rows = json::array();
+  for (std::uint32_t i = 0; i <= cm.virtual_tubes; ++i) {
+    json row = json::array();
+    for (std::uint32_t j = 0; j <= cm.real_tubes; ++j) row.push_back(cm.at(i, j));
+    rows.push_back(row);
+  }
+  json confusion = json::object();
+  confusion["rows"] = "virtual tubes in modeled order, then the null label c0";
+  confusion["columns"] = "real tubes, then the background (bin, ground, outliers)";
+  confusion["counts"] = rows;
+  return json{{"name", s.name},
+              {"source", s.source},
+              {"tube_count", s.tube_count},
+              {"scene_seed", s.scene_seed >= 0 ? json(s.scene_seed) : json(nullptr)},
+              {"input_points", s.input_points},
+              {"filtered_points", e.filtered_points},
+              {"segments", e.segments},
+              {"visible_sections", e.visible_sections},
+              {"segmentation_error", Optional(e.segmentation_error)},
+              {"virtual_tube_count", e.virtual_tubes.size()},
+              {"mean_length", Optional(e.mean_length)},
+              {"stddev_length", Optional(e.stddev_length)},
+              {"correct", e.correct},
+              {"partially_correct", e.partially_correct},
+              {"not_correct", e.not_correct},
+              {"hidden", e.hidden},
+              {"micro_recall", e.micro_recall()},
+              {"micro_precision", e.micro_precision()},
+              {"accuracy", e.accuracy()},
+              {"timings", Timings(e.timings)},
+              {"total_seconds", e.total_seconds},
+              {"real_tubes", real},
+              {"virtual_tubes", virt},
+              {"confusion", confusion}};
+}
+
+}  // namespace
+
+std::string FormatJsonReport(const EvalRun& run, const std::vector<ReportImage>& images) {
+  const EvaluationParams& p = run.evaluation_params;
+  json j;
+  j["command"] = run.command_line;
+  j["source"] = run.source;
+  j["profile"] = run.profile;
+  j["params_file"] = run.params_path;
+  j["joining_strategy"] = run.joining_strategy;
+  j["modeling_seed"] = run.modeling_seed;
+  j["jobs"] = run.jobs;
+  j["modeling_threads"] = run.modeling_threads;
+  j["wall_seconds"] = run.wall_seconds;
+  j["evaluation_params"] = {{"labelling_tolerance", p.labelling.tolerance},
+                            {"label_inside_cylinders", p.labelling.label_inside_cylinders},
+                            {"section_link_radius", p.sections.link_radius},
+                            {"section_min_points", p.sections.min_points},
+                            {"min_visible_points", p.min_visible_points},
+                            {"purity", p.purity},
+                            {"cylinder_purity", p.cylinder_purity},
+                            {"coverage", p.coverage},
+                            {"touch_fraction", p.touch_fraction},
+                            {"touch_min_points", p.touch_min_points}};
+  j["overall"] = AggregateJson(run.overall);
+  j["per_tube_count"] = json::array();
+  for (const EvaluationAggregate& a : run.rows) j["per_tube_count"].push_back(AggregateJson(a));
+  j["images"] = json::array();
+  for (const ReportImage& im : images)
+    j["images"].push_back({{"file", im.file}, {"caption", im.caption}, {"scene", im.scene}});
+  j["scenes"] = json::array();
+  for (const EvaluatedScene& s : run.scenes) j["scenes"].push_back(SceneJson(s));
+  j["params_yaml"] = run.params_yaml;
+  return j.dump(1) + "\n";
+}
+
+}  // namespace tubepick::cli

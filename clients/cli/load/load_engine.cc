@@ -1,0 +1,408 @@
+#include "clients/cli/load/load_engine.h"
+
+#include <fmt/core.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <future>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "core/common/errors.h"
+#include "core/modeling/cloud_io.h"
+#include "tubepick/v1/requests.pb.h"
+#include "tubepick/v1/service.grpc.pb.h"
+#include "wire/cloud_stream.h"
+#include "wire/packed_cloud.h"
+
+namespace tubepick::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kService = "/tubepick.v1.PickPlannerService/";
+
+std::string MethodName(LoadRpc rpc) {
+  switch (rpc) {
+    case LoadRpc::kPlanPick:
+      return std::string(kService) + "PlanPick";
+    case LoadRpc::kModelTubes:
+      return std::string(kService) + "ModelTubes";
+    case LoadRpc::kPlanPickStream:
+      return std::string(kService) + "PlanPickStream";
+  }
+  return {};
+}
+
+v1::PlanningOptions MakePlanningOptions(const LoadOptions& o) {
+  v1::PlanningOptions options;
+  options.set_profile(o.profile);
+  if (o.seed) options.set_seed(*o.seed);
+  options.set_disable_simulation(o.disable_simulation);
+  options.set_max_plans(o.max_plans);
+  return options;
+}
+
+/// A cloud's request, encoded once: the serialized unary request, or the stream's messages.
+struct PreparedCall {
+  grpc::ByteBuffer unary;
+  std::vector<v1::PlanPickStreamRequest> stream;
+};
+
+grpc::ByteBuffer Serialize(const google::protobuf::Message& message) {
+  std::string bytes;
+  message.SerializeToString(&bytes);
+  grpc::Slice slice(std::move(bytes));
+  return grpc::ByteBuffer(&slice, 1);
+}
+
+PreparedCall Prepare(const LoadOptions& o, const LoadCloud& cloud) {
+  PreparedCall call;
+  v1::PointCloud* pc = nullptr;
+  v1::ModelTubesRequest model;
+  v1::PlanPickRequest plan;
+  if (o.rpc == LoadRpc::kModelTubes) {
+    *model.mutable_options() = MakePlanningOptions(o);
+    pc = model.mutable_cloud();
+  } else {
+    *plan.mutable_options() = MakePlanningOptions(o);
+    pc = plan.mutable_cloud();
+  }
+  pc->set_unit(cloud.unit);
+  switch (o.rpc) {
+    case LoadRpc::kModelTubes:
+      pc->set_xyz(cloud.xyz);
+      call.unary = Serialize(model);
+      break;
+    case LoadRpc::kPlanPick:
+      pc->set_xyz(cloud.xyz);
+      call.unary = Serialize(plan);
+      break;
+    case LoadRpc::kPlanPickStream: {
+      call.stream = SplitCloudStream(plan, cloud.xyz, std::max<std::size_t>(1, o.chunk_bytes));
+      break;
+    }
+  }
+  return call;
+}
+
+/// One finished call.
+struct CallRecord {
+  double seconds = 0.0;
+  grpc::StatusCode code = grpc::StatusCode::OK;
+  std::string message;
+};
+
+/// Makes calls on one shared channel; thread-safe (each call has its own context).
+class Caller {
+ public:
+  Caller(std::shared_ptr<grpc::Channel> channel, const LoadOptions& options)
+      : options_(options),
+        method_(MethodName(options.rpc)),
+        generic_(channel),
+        stub_(v1::PickPlannerService::NewStub(channel)) {}
+
+  CallRecord Call(const PreparedCall& call) const {
+    grpc::ClientContext context;
+    if (options_.deadline_seconds > 0.0)
+      context.set_deadline(std::chrono::system_clock::now() +
+                           std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                               std::chrono::duration<double>(options_.deadline_seconds)));
+    const Clock::time_point t0 = Clock::now();
+    const grpc::Status status =
+        options_.rpc == LoadRpc::kPlanPickStream ? Stream(&context, call) : Unary(&context, call);
+    CallRecord record;
+    record.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    record.code = status.error_code();
+    record.message = status.error_message();
+    return record;
+  }
+
+ private:
+  grpc::Status Unary(grpc::ClientContext* context, const PreparedCall& call) const {
+    grpc::ByteBuffer response;
+    std::promise<grpc::Status> done;
+    std::future<grpc::Status> result = done.get_future();
+    generic_.UnaryCall(context, method_, grpc::StubOptions(), &call.unary, &response,
+                       [&done](grpc::Status status) { done.set_value(std::move(status)); });
+    return result.get();
+  }
+
+  grpc::Status Stream(grpc::ClientContext* context, const PreparedCall& call) const {
+    v1::PlanPickStreamResponse response;
+    std::unique_ptr<grpc::ClientWriter<v1::PlanPickStreamRequest>> writer =
+        stub_->PlanPickStream(context, &response);
+    for (const v1::PlanPickStreamRequest& message : call.stream) {
+      if (!writer->Write(message)) break;  // the server already answered (an error): Finish says why
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  }
+
+  const LoadOptions& options_;
+  const std::string method_;
+  mutable grpc::GenericStub generic_;
+  std::unique_ptr<v1::PickPlannerService::Stub> stub_;
+};
+
+/// Runs calls from `concurrency` threads until `count` calls started (count > 0) or `end` passed.
+/// `next` is the global round-robin position, shared across phases.
+std::vector<CallRecord> RunPhase(const Caller& caller, const std::vector<PreparedCall>& calls,
+                                 std::uint32_t concurrency, std::uint64_t count,
+                                 std::optional<Clock::time_point> end, std::atomic<std::uint64_t>& next) {
+  std::atomic<std::uint64_t> started{0};
+  std::mutex mutex;
+  std::vector<CallRecord> records;
+  std::vector<std::thread> workers;
+  for (std::uint32_t w = 0; w < concurrency; ++w) {
+    workers.emplace_back([&] {
+      std::vector<CallRecord> mine;
+      for (;;) {
+        if (count > 0 && started.fetch_add(1) >= count) break;
+        if (end && Clock::now() >= *end) break;
+        const std::uint64_t i = next.fetch_add(1);
+        mine.push_back(caller.Call(calls[i % calls.size()]));
+      }
+      std::lock_guard lock(mutex);
+      records.insert(records.end(), std::make_move_iterator(mine.begin()),
+                     std::make_move_iterator(mine.end()));
+    });
+  }
+  for (std::thread& t : workers) t.join();
+  return records;
+}
+
+std::string HumanBytes(double bytes) {
+  if (bytes >= 1e9) return fmt::format("{:.2f} GB", bytes / 1e9);
+  if (bytes >= 1e6) return fmt::format("{:.1f} MB", bytes / 1e6);
+  if (bytes >= 1e3) return fmt::format("{:.1f} kB", bytes / 1e3);
+  return fmt::format("{:.0f} B", bytes);
+}
+
+}  // namespace
+
+std::string ToString(LoadRpc rpc) {
+  switch (rpc) {
+    case LoadRpc::kPlanPick:
+      return "plan";
+    case LoadRpc::kModelTubes:
+      return "model";
+    case LoadRpc::kPlanPickStream:
+      return "plan-stream";
+  }
+  return "?";
+}
+
+LoadRpc ParseLoadRpc(const std::string& name) {
+  if (name == "plan") return LoadRpc::kPlanPick;
+  if (name == "model") return LoadRpc::kModelTubes;
+  if (name == "plan-stream") return LoadRpc::kPlanPickStream;
+  throw InvalidArgument("--rpc: '" + name + "' is not plan, model or plan-stream");
+}
+
+std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUnit unit) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(directory)) throw InvalidArgument("--clouds: '" + directory + "' is not a directory");
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(directory)) {
+    if (!e.is_regular_file()) continue;
+    std::string ext = e.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".ply" || ext == ".pcd") files.push_back(e.path());
+  }
+  if (files.empty()) throw InvalidArgument("--clouds: no .ply or .pcd file at or below '" + directory + "'");
+  std::sort(files.begin(), files.end());
+  std::vector<LoadCloud> clouds;
+  for (const fs::path& f : files) {
+    CloudFile file = ReadCloudFile(f.string());
+    clouds.push_back({f.string(), PackXyz(file.points), unit});
+  }
+  return clouds;
+}
+
+LatencySummary SummarizeLatency(std::vector<double> seconds) {
+  LatencySummary s;
+  if (seconds.empty()) return s;
+  std::sort(seconds.begin(), seconds.end());
+  const auto rank = [&](double q) {
+    // Nearest rank: the smallest value with at least q of the samples at or below it.
+    const auto n = static_cast<double>(seconds.size());
+    const std::size_t i = static_cast<std::size_t>(std::max(1.0, std::ceil(q * n))) - 1;
+    return seconds[std::min(i, seconds.size() - 1)];
+  };
+  s.min = seconds.front();
+  s.max = seconds.back();
+  double sum = 0.0;
+  for (double v : seconds) sum += v;
+  s.mean = sum / static_cast<double>(seconds.size());
+  s.p50 = rank(0.50);
+  s.p90 = rank(0.90);
+  s.p95 = rank(0.95);
+  s.p99 = rank(0.99);
+  return s;
+}
+
+LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
+  if (clouds.empty()) throw InvalidArgument("--clouds: no clouds to send");
+  if (o.concurrency == 0) throw InvalidArgument("--concurrency: must be at least 1");
+  if (o.total == 0 && !(o.duration_seconds > 0.0))
+    throw InvalidArgument("--total or --duration: give a positive call count or duration");
+  if (o.rpc == LoadRpc::kPlanPickStream && o.chunk_bytes == 0)
+    throw InvalidArgument("chunk size: must be positive");
+
+  std::vector<PreparedCall> calls;
+  calls.reserve(clouds.size());
+  double cloud_bytes = 0.0;
+  for (const LoadCloud& c : clouds) {
+    calls.push_back(Prepare(o, c));
+    cloud_bytes += static_cast<double>(c.xyz.size());
+  }
+
+  std::shared_ptr<grpc::Channel> channel = MakeChannel(o.channel);
+  const auto connect_deadline =
+      std::chrono::system_clock::now() + std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                                             std::chrono::duration<double>(o.connect_timeout_seconds));
+  if (!channel->WaitForConnected(connect_deadline))
+    throw InvalidArgument(fmt::format("--target: cannot connect to '{}' within {} s", o.channel.target,
+                                      o.connect_timeout_seconds));
+  const Caller caller(channel, o);
+
+  std::atomic<std::uint64_t> next{0};
+  if (o.warmup > 0) RunPhase(caller, calls, o.concurrency, o.warmup, std::nullopt, next);
+
+  std::optional<RssSampler> sampler;
+  if (!o.metrics_url.empty())
+    sampler.emplace(o.metrics_url, std::chrono::milliseconds(static_cast<long long>(
+                                       std::max(0.1, o.metrics_interval_seconds) * 1000.0)));
+  const Clock::time_point t0 = Clock::now();
+  std::optional<Clock::time_point> end;
+  if (o.total == 0)
+    end = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.duration_seconds));
+  const std::vector<CallRecord> records = RunPhase(caller, calls, o.concurrency, o.total, end, next);
+  const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  LoadReport report;
+  report.rpc = ToString(o.rpc);
+  report.method = MethodName(o.rpc).substr(1);
+  report.target = o.channel.target;
+  report.concurrency = o.concurrency;
+  report.clouds = clouds.size();
+  report.mean_cloud_bytes = cloud_bytes / static_cast<double>(clouds.size());
+  report.warmup = o.warmup;
+  report.total = records.size();
+  report.elapsed_seconds = elapsed;
+  std::vector<double> ok_seconds;
+  for (const CallRecord& r : records) {
+    const std::string code = StatusCodeName(r.code);
+    ++report.status_counts[code];
+    if (r.code == grpc::StatusCode::OK) {
+      ok_seconds.push_back(r.seconds);
+    } else if (!report.error_examples.contains(code)) {
+      report.error_examples[code] = r.message;
+    }
+  }
+  report.ok = ok_seconds.size();
+  if (elapsed > 0.0) {
+    report.requests_per_second = static_cast<double>(report.total) / elapsed;
+    report.ok_per_second = static_cast<double>(report.ok) / elapsed;
+  }
+  report.latency = SummarizeLatency(std::move(ok_seconds));
+  if (sampler) report.rss = sampler->Stop();
+  return report;
+}
+
+std::string FormatLoadReportText(const LoadReport& r) {
+  std::string out;
+  const auto line = [&out](const std::string& text) { out += text + "\n"; };
+  line("Summary:");
+  line(fmt::format("  RPC:          {} ({})", r.rpc, r.method));
+  line(fmt::format("  Target:       {}", r.target));
+  line(fmt::format("  Clouds:       {} (mean {} a cloud, {:.2f} M points)", r.clouds,
+                   HumanBytes(r.mean_cloud_bytes), r.mean_cloud_bytes / 12.0 / 1e6));
+  line(fmt::format("  Concurrency:  {}", r.concurrency));
+  line(fmt::format("  Count:        {} ({} OK){}", r.total, r.ok,
+                   r.warmup ? fmt::format(", after {} warm-up", r.warmup) : ""));
+  line(fmt::format("  Total:        {:.3f} s", r.elapsed_seconds));
+  line(fmt::format("  Requests/sec: {:.3f} (OK: {:.3f}/s)", r.requests_per_second, r.ok_per_second));
+  line("");
+  if (r.ok > 0) {
+    line("Latency of successful calls (s):");
+    line(fmt::format("  {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}", "min", "mean", "p50", "p90", "p95", "p99",
+                     "max"));
+    const LatencySummary& l = r.latency;
+    line(fmt::format("  {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f} {:>9.4f}", l.min, l.mean, l.p50,
+                     l.p90, l.p95, l.p99, l.max));
+  } else {
+    line("Latency: no successful call");
+  }
+  line("");
+  line("Status code distribution:");
+  for (const auto& [code, count] : r.status_counts) {
+    std::string text = fmt::format("  [{}] {} responses", code, count);
+    if (const auto e = r.error_examples.find(code); e != r.error_examples.end())
+      text += fmt::format("  (first: {})", e->second);
+    line(text);
+  }
+  if (r.rss) {
+    const RssSummary& m = *r.rss;
+    line("");
+    line(fmt::format("Server RSS (process_resident_memory_bytes from {}, every {:.1f} s, {} samples{}):",
+                     m.url, m.interval_seconds, m.samples.size(),
+                     m.failed_scrapes ? fmt::format(", {} failed scrapes", m.failed_scrapes) : ""));
+    if (m.samples.empty()) {
+      line("  no sample");
+    } else {
+      line(fmt::format("  first {:.0f} s max {}, last {:.0f} s max {} ({:+.1f} %), peak {}", m.window_seconds,
+                       HumanBytes(static_cast<double>(m.first_window_max)), m.window_seconds,
+                       HumanBytes(static_cast<double>(m.last_window_max)), m.growth_percent,
+                       HumanBytes(static_cast<double>(m.peak))));
+    }
+  }
+  return out;
+}
+
+std::string FormatLoadReportJson(const LoadReport& r) {
+  nlohmann::json j;
+  j["rpc"] = r.rpc;
+  j["method"] = r.method;
+  j["target"] = r.target;
+  j["concurrency"] = r.concurrency;
+  j["clouds"] = r.clouds;
+  j["mean_cloud_bytes"] = r.mean_cloud_bytes;
+  j["warmup"] = r.warmup;
+  j["count"] = r.total;
+  j["ok"] = r.ok;
+  j["total_seconds"] = r.elapsed_seconds;
+  j["requests_per_second"] = r.requests_per_second;
+  j["ok_per_second"] = r.ok_per_second;
+  const LatencySummary& l = r.latency;
+  j["latency_seconds"] = {{"min", l.min}, {"mean", l.mean}, {"p50", l.p50}, {"p90", l.p90},
+                          {"p95", l.p95}, {"p99", l.p99},   {"max", l.max}};
+  j["status_counts"] = r.status_counts;
+  j["error_examples"] = r.error_examples;
+  if (r.rss) {
+    const RssSummary& m = *r.rss;
+    nlohmann::json samples = nlohmann::json::array();
+    for (const RssSample& s : m.samples) samples.push_back({{"seconds", s.seconds}, {"bytes", s.bytes}});
+    j["server_rss"] = {{"url", m.url},
+                       {"interval_seconds", m.interval_seconds},
+                       {"window_seconds", m.window_seconds},
+                       {"first_window_max_bytes", m.first_window_max},
+                       {"last_window_max_bytes", m.last_window_max},
+                       {"peak_bytes", m.peak},
+                       {"growth_percent", m.growth_percent},
+                       {"failed_scrapes", m.failed_scrapes},
+                       {"samples", samples}};
+  }
+  return j.dump(2) + "\n";
+}
+
+}  // namespace tubepick::cli

@@ -1,0 +1,122 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "clients/cli/load/load_metrics.h"
+#include "clients/cli/remote/channel.h"
+#include "core/common/types.h"
+#include "tubepick/v1/types.pb.h"
+
+namespace tubepick::cli {
+
+/// Which PickPlannerService RPC the load generator calls.
+enum class LoadRpc { kPlanPick, kModelTubes, kPlanPickStream };
+
+/// "plan", "model", "plan-stream" (the --rpc names).
+std::string ToString(LoadRpc rpc);
+/// @throws InvalidArgument naming --rpc for anything else.
+LoadRpc ParseLoadRpc(const std::string& name);
+
+/// One recorded cloud, already packed for the wire.
+struct LoadCloud {
+  /// Where it came from (a file path, or a test's label).
+  std::string name;
+  /// Packed little-endian float32 x, y, z (PointCloud.xyz). Sent as is, so a test may pass bytes
+  /// the server must reject.
+  std::string xyz;
+  /// PointCloud.unit; UNSPECIFIED = the server's cell unit.
+  v1::LengthUnit unit = v1::LENGTH_UNIT_UNSPECIFIED;
+};
+
+/// Every *.ply and *.pcd file at or below `directory` (e.g. a tree of `tubepick scene` outputs),
+/// sorted by path, read with ReadCloudFile and packed; non-finite points are kept (the server
+/// drops them). @throws InvalidArgument when the directory holds no cloud or a file is unreadable.
+std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUnit unit);
+
+/// What to send, how often and how many at once.
+struct LoadOptions {
+  ChannelOptions channel;
+  LoadRpc rpc = LoadRpc::kPlanPick;
+  /// Calls in flight at once: one worker thread each, all on one channel.
+  std::uint32_t concurrency = 1;
+  /// Measured calls; 0 = run for duration_seconds instead.
+  std::uint64_t total = 0;
+  /// Measured phase length when total == 0, seconds: no call starts after it (calls in flight
+  /// finish and count).
+  double duration_seconds = 0.0;
+  /// Calls made before the measured phase (same concurrency), not counted.
+  std::uint64_t warmup = 0;
+  /// Deadline of each call, seconds; 0 = none.
+  double deadline_seconds = 0.0;
+  /// PlanningOptions sent with every call.
+  std::string profile;  ///< empty = the server's profile
+  std::optional<std::uint64_t> seed;
+  bool disable_simulation = false;
+  std::uint32_t max_plans = 0;
+  /// PlanPickStream chunk size, bytes.
+  std::size_t chunk_bytes = 1 << 20;
+  /// Prometheus endpoint of the server (http://HOST:PORT/metrics); empty = no RSS sampling.
+  std::string metrics_url;
+  double metrics_interval_seconds = 5.0;
+  /// How long to wait for the channel to connect before giving up, seconds.
+  double connect_timeout_seconds = 10.0;
+};
+
+/// Latency of the successful calls, seconds (nearest-rank percentiles). All zero without one.
+struct LatencySummary {
+  double min = 0.0;
+  double mean = 0.0;
+  double p50 = 0.0;
+  double p90 = 0.0;
+  double p95 = 0.0;
+  double p99 = 0.0;
+  double max = 0.0;
+};
+
+/// Nearest-rank percentiles of `seconds` (any order). Empty input gives all zeros.
+LatencySummary SummarizeLatency(std::vector<double> seconds);
+
+/// The outcome of one load run (measured phase only), like ghz's summary.
+struct LoadReport {
+  std::string rpc;     ///< "plan", "model", "plan-stream"
+  std::string method;  ///< full gRPC method name
+  std::string target;
+  std::uint32_t concurrency = 0;
+  std::uint64_t clouds = 0;
+  /// Mean request payload (cloud bytes) per call.
+  double mean_cloud_bytes = 0.0;
+  std::uint64_t warmup = 0;
+  /// Measured calls (any status), of which `ok` succeeded.
+  std::uint64_t total = 0;
+  std::uint64_t ok = 0;
+  /// Calls by status code name ("OK", "RESOURCE_EXHAUSTED", ...), OK included.
+  std::map<std::string, std::uint64_t> status_counts;
+  /// The first message seen for each non-OK code.
+  std::map<std::string, std::string> error_examples;
+  /// Wall time of the measured phase, seconds.
+  double elapsed_seconds = 0.0;
+  /// total / elapsed and ok / elapsed.
+  double requests_per_second = 0.0;
+  double ok_per_second = 0.0;
+  LatencySummary latency;
+  /// Present when metrics_url was given.
+  std::optional<RssSummary> rss;
+};
+
+/// Runs the load: connects, optionally warms up, then sends the clouds round-robin from
+/// `concurrency` threads (each with one call in flight) until `total` calls completed or
+/// `duration_seconds` passed. Call failures are counted by status code, never thrown.
+/// @throws InvalidArgument for inconsistent options (no clouds, concurrency 0, neither total nor
+///         duration) or when the target does not connect within connect_timeout_seconds.
+LoadReport RunLoad(const LoadOptions& options, const std::vector<LoadCloud>& clouds);
+
+/// ghz-like text summary (several lines, ends with a newline).
+std::string FormatLoadReportText(const LoadReport& report);
+/// The same as JSON (seconds, bytes; RSS samples included).
+std::string FormatLoadReportJson(const LoadReport& report);
+
+}  // namespace tubepick::cli

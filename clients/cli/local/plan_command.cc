@@ -1,0 +1,91 @@
+#include "clients/cli/local/plan_command.h"
+
+#include <fmt/core.h>
+
+#include <memory>
+
+#include "clients/cli/inputs/cli_inputs.h"
+#include "core/modeling/model_tubes.h"
+#include "core/planning/pick_planner.h"
+#include "core/planning/plan_placement.h"
+#include "physics/trajectory_simulator.h"
+#include "wire/proto_convert.h"
+#include "wire/response_convert.h"
+
+namespace tubepick::cli {
+namespace {
+
+struct PlanOptions {
+  InputOptions input;
+  std::string json_path;
+  bool no_sim = false;
+  std::uint32_t sim_threads = 0;
+  std::uint32_t show = 5;
+};
+
+const char* OcclusionName(Occlusion o) {
+  switch (o) {
+    case Occlusion::kNone:
+      return "none";
+    case Occlusion::kWeak:
+      return "weak";
+    case Occlusion::kStrong:
+      return "strong";
+    case Occlusion::kUnspecified:
+      break;
+  }
+  return "-";
+}
+
+void Run(const PlanOptions& o) {
+  const CommonOptions& common = o.input.common;
+  const CellConfig cell = LoadCell(common);
+  const Params params = LoadParamsFor(common);
+  const CloudInput cloud = LoadCloudInput(o.input, cell);
+  const ModelingInput input = MakeModelingInput(cloud, cell, common.seed);
+  const ModelingResult modeling = ModelTubes(input, params.modeling);
+
+  physics::BulletTrajectoryEvaluator evaluator(physics::SimParamsForCell(
+      {}, cell, params.planning.cost.max_displacement, static_cast<int>(o.sim_threads)));
+  PickPlanResult plan =
+      PlanPick(modeling, cell, params.planning, o.no_sim ? nullptr : &evaluator, common.seed);
+  AttachPlacements(modeling, cell.place.X_BinPlace, params.placement, &plan);
+
+  fmt::print("{}, profile {}, seed {}\n", cloud.source, common.profile, common.seed);
+  fmt::print("modeling {:.3f} s: {} tubes; planning {:.3f} s: {} plans{}{}\n", modeling.total_seconds,
+             modeling.tubes.size(), plan.total_seconds, plan.plans.size(),
+             plan.used_simulation ? " (trajectories simulated)" : "", plan.bin_empty ? "; BIN EMPTY" : "");
+  fmt::print("{:>5} {:>9} {:>9}\n", "tube", "length_m", "occlusion");
+  for (const Tube& t : plan.tubes)
+    fmt::print("{:>5} {:>9.3f} {:>9}\n", t.id, t.length(), OcclusionName(t.occlusion));
+  fmt::print("{:>4} {:>5} {:>17} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
+             "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
+  for (std::size_t i = 0; i < plan.plans.size() && i < o.show; ++i) {
+    const PickPlan& p = plan.plans[i];
+    const Eigen::Vector3d g = p.grasp.p_Bin_grasp;
+    fmt::print("{:>4} {:>5} {:>17} ({:+.3f}, {:+.3f}, {:+.3f}) {:>7.3f} {:>7.3f} {:>7.3f} {:>7.3f} {:>9}\n",
+               i, p.tube_id, ToString(p.kind), g.x(), g.y(), g.z(), p.costs.height, p.costs.centre,
+               p.costs.trajectory, p.costs.total,
+               p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
+  }
+  if (!o.json_path.empty()) {
+    WriteTextFile(o.json_path, ToJson(ToPlanPickResponse(plan, modeling, common.profile, common.seed)));
+    fmt::print("wrote {}\n", o.json_path);
+  }
+}
+
+}  // namespace
+
+void AddPlanCommand(CLI::App& app) {
+  auto o = std::make_shared<PlanOptions>();
+  CLI::App* cmd = app.add_subcommand("plan", "Plan ranked picks for a cloud (thesis chapter 5)");
+  AddInputOptions(cmd, o->input);
+  cmd->add_option("--json", o->json_path, "Write the PlanPickResponse as proto3 JSON");
+  cmd->add_flag("--no-sim", o->no_sim, "Never simulate trajectories (occluded tubes get T = 0)");
+  cmd->add_option("--sim-threads", o->sim_threads, "Simulation worker threads (0 = all cores)")
+      ->capture_default_str();
+  cmd->add_option("--show", o->show, "Plans to print")->capture_default_str();
+  cmd->callback([o] { Run(*o); });
+}
+
+}  // namespace tubepick::cli
