@@ -4,6 +4,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include "clients/cell/cell_controller_params.h"
 #include "clients/cell/cell_fault.h"
 #include "clients/cell/cell_records.h"
+#include "clients/cell/nudge.h"
 #include "clients/cell/planner_client.h"
 #include "core/common/cell_config.h"
 #include "devices/force_torque_sensor.h"
@@ -113,6 +115,12 @@ struct CellRunResult {
 ///   truth_before / truth_after (the annotator's object, when set).
 /// A safe stop writes {"type": "safe_stop", ...}; every run ends with {"type": "end", reason,
 /// message, picks, attempts, scans, nudges, truth}.
+///
+/// Poses are named for their frames: X_BinTcp… is a TCP pose in the bin frame (X_BinTcpGrasp,
+/// X_BinTcpPreGrasp, X_BinTcpLift, X_BinTcpPlace, X_BinHome), p_Bin_… a position in it. The source
+/// is cut by step: cell_controller.cc (the run: start, scan, plan, attempts, nudge, safe stop),
+/// cell_attempt.cc (one attempt: approach … place / resolve / put back), cell_device_calls.cc (the
+/// device and planner calls), attempt_record.cc (the records' parts).
 class CellController {
  public:
   /// @throws InvalidArgument when a device pointer is null or params/cell are invalid.
@@ -133,37 +141,93 @@ class CellController {
   CellState state() const { return state_; }
 
  private:
-  struct Attempt;
+  struct Attempt;      ///< one picking attempt (or nudge) under way: its record and durations
+  struct RunState;     ///< one run's counters, result and the attempt under way
+  struct PlannedScan;  ///< one scan and the planner's answer to it
+  struct PlanPoses;    ///< the TCP poses of one plan, bin frame
   enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed };
 
+  // The run (cell_controller.cc): start, then scan → plan → attempts or a nudge, until a stop.
   void StartCell();
+  /// Why no further attempt may be made (an attempt limit), or nullopt.
+  std::optional<std::string> LimitReached(const RunState& run) const;
+  /// One scan and what follows it; false when the run ends (limit reached, bin empty).
+  bool ScanAndPick(RunState& run);
+  PlannedScan ScanBin(RunState& run);
+  void PlanPick(const devices::Capture& capture, PlannedScan& scan);
+  /// The scan's plans in rank order, skipping those that cannot be executed; returns how many ran.
+  std::uint32_t TryPlans(PlannedScan& scan, RunState& run);
+  AttemptResult PickAttempt(PlannedScan& scan, int rank, bool first_of_scan, RunState& run);
+  Attempt& BeginAttempt(PlannedScan& scan, int rank, bool first_of_scan, RunState& run);
+  AttemptResult FinishAttempt(RunState& run);
+  /// Counts the attempt's outcome; true when the next plan of the same scan may be tried.
+  bool CountAttempt(AttemptResult outcome, RunState& run);
+  /// A scan without an executable plan: a "no_plan" record, or a nudge and its record.
+  void NoExecutablePlan(PlannedScan& scan, RunState& run);
+  std::optional<NudgePlan> PlanNudgeIfAllowed(const v1::PlanPickResponse& response,
+                                              const RunState& run) const;
+  nlohmann::json Nudge(const NudgePlan& nudge, nlohmann::json record, const PlannedScan& scan, RunState& run);
+  /// The "type": "attempt" record's common fields; truth_before is the scan's for rank 0.
+  nlohmann::json BaseRecord(const PlannedScan& scan, int rank, std::uint32_t attempt);
+  /// The attempt under way when `fault` stopped the run, recorded as "fault".
+  void RecordFaultedAttempt(RunState& run, const CellFault& fault);
+  void SafeStop(const CellFault& fault, CellRunResult& result);
+  std::string SafeStopOpenGripper(CellRunResult& result);
+  std::string SafeStopMoveUp(CellRunResult& result);
+
+  // One picking attempt (cell_attempt.cc): approach, reference, grasp, lift, analyze, then place,
+  // resolve or put back.
   /// Why a plan cannot be executed: a pose beyond the robot's limits, or ToolClearanceProblem (when
   /// that check is on); nullopt when it can.
   std::optional<std::string> ClearanceProblem(const v1::PickPlan& plan, int rank) const;
-  void ExecutePlan(const v1::PlanPickResponse& response, int plan_index, Attempt& attempt);
-  void Place(const Eigen::Isometry3d& X_place, Attempt& attempt);
+  PlanPoses PosesOf(const v1::PickPlan& plan, int rank) const;
+  void ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& attempt);
+  void Approach(const Eigen::Isometry3d& X_BinTcpPreGrasp, double opening_width, Attempt& attempt);
+  devices::WrenchReading TakeReference(Attempt& attempt);
+  /// Down to the grasp pose and close; whether the gripper reports an object.
+  bool Grasp(const Eigen::Isometry3d& X_BinTcpGrasp, Attempt& attempt);
+  void ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpPreGrasp, Attempt& attempt);
+  /// Along the plan's waypoints; returns the lift pose.
+  Eigen::Isometry3d Lift(const std::vector<Eigen::Vector3d>& waypoints_Bin, Attempt& attempt);
+  v1::AnalyzeWrenchResponse AnalyzeLift(const devices::WrenchReading& reference,
+                                        const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+  /// SINGLE: place; NONE: release; MULTIPLE: nullopt (resolve).
+  std::optional<AttemptResult> Conclude(v1::HeldOutcome outcome, const Eigen::Isometry3d& X_BinTcpPlace,
+                                        Attempt& attempt);
+  AttemptResult Resolve(const v1::AnalyzeWrenchResponse& analysis, const devices::WrenchReading& reference,
+                        const PlanPoses& poses, const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+  /// Resolution motion `m`, back to the lift pose, a new reading and its analysis.
+  v1::AnalyzeWrenchResponse ResolutionMotion(const v1::ResolutionMotion& motion, int m,
+                                             const devices::WrenchReading& reference,
+                                             const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+  void Place(const Eigen::Isometry3d& X_BinTcpPlace, Attempt& attempt);
+  void ReleaseEmpty(Attempt& attempt);
+  /// Several tubes held after every resolution motion: lower them back into the bin and open.
+  void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
+               Attempt& attempt);
   /// The nudge skill's motions (kNudge), from home back to home.
   void ExecuteNudge(const NudgePlan& plan, Attempt& attempt);
-  void ReturnToBin(const Eigen::Isometry3d& X_grasp, const Eigen::Isometry3d& X_lift, Attempt& attempt);
-  void OpenGripper();
-  v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,
-                                    const devices::WrenchReading& current, const Eigen::Isometry3d& X_lift,
-                                    Attempt& attempt);
+  void GoHome(Attempt* attempt);
 
-  // Devices, each call timed and its failures turned into CellFault.
+  // Devices and planner calls (cell_device_calls.cc), each timed and its failures turned into
+  // CellFault.
   devices::Capture Scan();
   /// Runs a robot motion through CallDevice and adds its wall and device time to `attempt`.
   template <typename Motion>
   void TimedRobotMotion(Attempt* attempt, const Motion& motion);
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
-  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Attempt* attempt);
+  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed, Attempt* attempt);
   Eigen::Isometry3d CurrentPose();
   /// Up to transit height, across, down to `X_BinTcp`.
   void TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt);
   devices::GripperStatus CheckGripper(const devices::GripperStatus& status);
+  void OpenGripper();
+  devices::GripperStatus CloseGripper();
   devices::WrenchReading ReadWrench();
+  v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,
+                                    const devices::WrenchReading& current,
+                                    const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
 
-  void SafeStop(const CellFault& fault, CellRunResult& result);
   void Enter(CellState state);
   nlohmann::json Truth() const;
   double DeviceNow() const;

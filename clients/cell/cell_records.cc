@@ -5,11 +5,6 @@
 #include "core/common/errors.h"
 
 namespace tubepick::cell {
-namespace {
-
-nlohmann::json Vec(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
-
-}  // namespace
 
 JsonLinesFileSink::JsonLinesFileSink(const std::string& path, bool append)
     : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
@@ -37,13 +32,15 @@ std::vector<nlohmann::json> ReadJsonLines(const std::string& path) {
   return records;
 }
 
+nlohmann::json VectorJson(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
 nlohmann::json PoseJson(const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.rotation());
-  return {{"position", Vec(X.translation())}, {"orientation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+  return {{"position", VectorJson(X.translation())}, {"orientation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
 nlohmann::json WrenchJson(const devices::WrenchReading& reading) {
-  return {{"force", Vec(reading.force)}, {"torque", Vec(reading.torque)}};
+  return {{"force", VectorJson(reading.force)}, {"torque", VectorJson(reading.torque)}};
 }
 
 std::string GripperObjectName(devices::GripperObject object) {

@@ -60,7 +60,9 @@ class TeeRecordSink final : public RecordSink {
 /// Reads a JSON-lines file back (blank lines skipped). @throws InvalidArgument naming the line.
 std::vector<nlohmann::json> ReadJsonLines(const std::string& path);
 
-/// {"position": [x, y, z], "orientation_xyzw": [x, y, z, w]}.
+/// [x, y, z].
+nlohmann::json VectorJson(const Eigen::Vector3d& v);
+/// {"position": [x, y, z], "orientation_xyzw": [x, y, z, w]} of X_BinTcp (or any pose).
 nlohmann::json PoseJson(const Eigen::Isometry3d& X);
 /// {"force": [x, y, z], "torque": [x, y, z]}.
 nlohmann::json WrenchJson(const devices::WrenchReading& reading);

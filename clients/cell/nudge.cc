@@ -11,12 +11,12 @@ namespace tubepick::cell {
 namespace {
 
 struct Sample {
-  Eigen::Vector3d p;
+  Eigen::Vector3d p_Bin;  // on the tube's axis
   double radius = 0.0;
   double fraction = 0.0;  // along the tube's cylinders
 };
 
-/// Distance of xy point p to each wall (+x, −x, +y, −y) and that wall's inward normal.
+/// Distance of xy point p_Bin to each wall (+x, −x, +y, −y) and that wall's inward normal.
 struct Walls {
   std::array<double, 4> distance{};
   static Eigen::Vector3d Inward(int w) {
@@ -33,10 +33,10 @@ struct Walls {
   }
 };
 
-Walls WallDistances(const Eigen::Vector3d& p, const CellConfig& cell) {
+Walls WallDistances(const Eigen::Vector3d& p_Bin, const CellConfig& cell) {
   const Eigen::Vector3d half = 0.5 * cell.bin.inner_size;
   Walls w;
-  w.distance = {half.x() - p.x(), half.x() + p.x(), half.y() - p.y(), half.y() + p.y()};
+  w.distance = {half.x() - p_Bin.x(), half.x() + p_Bin.x(), half.y() - p_Bin.y(), half.y() + p_Bin.y()};
   return w;
 }
 
@@ -47,13 +47,13 @@ std::vector<Sample> SampleTube(const v1::Tube& tube, double spacing, double defa
   if (!(total > 0.0)) return samples;
   double offset = 0.0;
   for (const v1::Cylinder& c : tube.cylinders()) {
-    const Eigen::Vector3d a = FromProto(c.start()), b = FromProto(c.end());
-    const double length = (b - a).norm();
+    const Eigen::Vector3d p_Bin_start = FromProto(c.start()), p_Bin_end = FromProto(c.end());
+    const double length = (p_Bin_end - p_Bin_start).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(length / spacing)));
     const double radius = c.radius() > 0.0 ? c.radius() : default_radius;
     for (int k = 0; k <= n; ++k) {
       const double t = static_cast<double>(k) / n;
-      samples.push_back({a + t * (b - a), radius, (offset + t * length) / total});
+      samples.push_back({p_Bin_start + t * (p_Bin_end - p_Bin_start), radius, (offset + t * length) / total});
     }
     offset += length;
   }
@@ -83,7 +83,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
   for (int i = 0; i < tubes.size(); ++i) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const Sample& s : SampleTube(tubes[i], params.sample_spacing, cell.tube.radius)) {
-      const Walls w = WallDistances(s.p, cell);
+      const Walls w = WallDistances(s.p_Bin, cell);
       nearest = std::min(nearest, *std::min_element(w.distance.begin(), w.distance.end()));
     }
     if (nearest < params.near_wall_distance)
@@ -104,7 +104,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
       return std::abs(a.fraction - fraction) < std::abs(b.fraction - fraction);
     });
     for (const Sample& s : samples) {
-      const Walls w = WallDistances(s.p, cell);
+      const Walls w = WallDistances(s.p_Bin, cell);
       Eigen::Vector3d direction = Eigen::Vector3d::Zero();
       double nearest = std::numeric_limits<double>::infinity();
       for (int k = 0; k < 4; ++k) {
@@ -116,32 +116,32 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
 
       NudgePlan plan;
       plan.tube_id = tube.id();
-      plan.p_Bin_contact = s.p;
+      plan.p_Bin_contact = s.p_Bin;
       plan.wall_distance = nearest;
       plan.direction = direction;
       plan.distance = std::clamp(params.push_gain * (params.target_wall_distance - nearest), params.min_push,
                                  params.max_push);
       // z_Tcp down, x_Tcp along the push: the housing's narrow side faces the wall.
-      Eigen::Matrix3d R;
-      R.col(0) = direction;
-      R.col(2) = -Eigen::Vector3d::UnitZ();
-      R.col(1) = R.col(2).cross(R.col(0));
-      R = R * Eigen::AngleAxisd(-params.tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
-      const double pad_bottom = s.p.z() + s.radius - params.press_depth;
+      Eigen::Matrix3d R_BinTcp;
+      R_BinTcp.col(0) = direction;
+      R_BinTcp.col(2) = -Eigen::Vector3d::UnitZ();
+      R_BinTcp.col(1) = R_BinTcp.col(2).cross(R_BinTcp.col(0));
+      R_BinTcp = R_BinTcp * Eigen::AngleAxisd(-params.tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const double pad_bottom = s.p_Bin.z() + s.radius - params.press_depth;
       // The pads (tool.finger_size.x along the push) must still cover the tube's top.
       const double max_shift = 0.5 * tool.finger_size.x() + 0.5 * s.radius;
       const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
                                                  plan.distance * direction + Eigen::Vector3d(0, 0, lift)};
       for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
-        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-        X.linear() = R;
+        Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
+        X_BinTcpPress.linear() = R_BinTcp;
         // The pads' bottom centre (tool.finger_tip_depth along z_Tcp) on the contact point.
-        Eigen::Vector3d tip = s.p + shift * direction;
-        tip.z() = pad_bottom;
-        X.translation() = tip - tool.finger_tip_depth * R.col(2);
-        if (ToolClearanceProblem(cell, tool, X, 0.0, path)) continue;
+        Eigen::Vector3d p_Bin_tip = s.p_Bin + shift * direction;
+        p_Bin_tip.z() = pad_bottom;
+        X_BinTcpPress.translation() = p_Bin_tip - tool.finger_tip_depth * R_BinTcp.col(2);
+        if (ToolClearanceProblem(cell, tool, X_BinTcpPress, 0.0, path)) continue;
         plan.shift = shift;
-        plan.X_BinTcp_press = X;
+        plan.X_BinTcpPress = X_BinTcpPress;
         return plan;
       }
     }

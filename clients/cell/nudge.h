@@ -59,7 +59,7 @@ struct NudgePlan {
   /// Push length, metres.
   double distance = 0.0;
   /// TCP at the bottom of the press (gripper closed, z_Tcp down, x_Tcp = direction).
-  Eigen::Isometry3d X_BinTcp_press = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
 };
 
 /// A nudge for one of `tubes` (the planner's modeled tubes, bin frame), or nullopt when no tube
@@ -73,7 +73,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
                                    const CellConfig& cell, const ToolGeometry& tool,
                                    const NudgeParams& params, double lift, std::uint32_t try_index);
 
-/// Waypoints of the push and the lift after it, relative to X_BinTcp_press (for Robot::MoveThrough).
+/// Waypoints of the push and the lift after it, relative to X_BinTcpPress (for Robot::MoveThrough).
 std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan);
 
 }  // namespace tubepick::cell

@@ -3,10 +3,10 @@
 namespace tubepick::cell {
 
 std::optional<std::string> ToolClearanceProblem(const CellConfig& cell, const ToolGeometry& tool,
-                                                const Eigen::Isometry3d& X_BinTcp_grasp, double opening,
+                                                const Eigen::Isometry3d& X_BinTcpGrasp, double opening,
                                                 const std::vector<Eigen::Vector3d>& waypoints) {
   const std::optional<ToolClearanceIssue> issue =
-      tubepick::ToolClearanceProblem(cell.bin, tool, X_BinTcp_grasp, opening, waypoints);
+      tubepick::ToolClearanceProblem(cell.bin, tool, X_BinTcpGrasp, opening, waypoints);
   if (!issue) return std::nullopt;
   return issue->ToString();
 }

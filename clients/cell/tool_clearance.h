@@ -19,11 +19,11 @@ namespace tubepick::cell {
 /// CellControllerParams::check_tool_clearance).
 using ToolGeometry = ToolParams;
 
-/// Why the tool, opened to `opening` and at X_BinTcp_grasp moved through `waypoints` (relative
+/// Why the tool, opened to `opening` and at X_BinTcpGrasp moved through `waypoints` (relative
 /// translations, bin axes), would touch a bin wall or the floor, or nullopt when it stays clear:
 /// tubepick::ToolClearanceProblem on the cell's bin, as one line.
 std::optional<std::string> ToolClearanceProblem(const CellConfig& cell, const ToolGeometry& tool,
-                                                const Eigen::Isometry3d& X_BinTcp_grasp, double opening,
+                                                const Eigen::Isometry3d& X_BinTcpGrasp, double opening,
                                                 const std::vector<Eigen::Vector3d>& waypoints);
 
 }  // namespace tubepick::cell

@@ -50,9 +50,9 @@ class CellControllerTest : public ::testing::Test {
     return out;
   }
 
-  /// Waypoint `X` added to motion `m` of `response`.
-  static void AddWaypoint(v1::AnalyzeWrenchResponse& response, int m, const Eigen::Isometry3d& X) {
-    *response.mutable_resolution_motions(m)->add_waypoints()->mutable_tcp_pose() = ToProto(X);
+  /// Waypoint `X_BinTcp` added to motion `m` of `response`.
+  static void AddWaypoint(v1::AnalyzeWrenchResponse& response, int m, const Eigen::Isometry3d& X_BinTcp) {
+    *response.mutable_resolution_motions(m)->add_waypoints()->mutable_tcp_pose() = ToProto(X_BinTcp);
   }
 
   testing::ScriptedScanner scanner;
@@ -63,7 +63,7 @@ class CellControllerTest : public ::testing::Test {
   MemoryRecordSink sink;
   CellConfig cell;
   CellControllerParams params;
-  const Eigen::Vector3d p_grasp{0.1, -0.05, 0.03};
+  const Eigen::Vector3d p_Bin_grasp{0.1, -0.05, 0.03};
 };
 
 TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
@@ -75,8 +75,8 @@ TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
   EXPECT_EQ(gripper.activations, 1);
   EXPECT_EQ(ft.biases, 1);
   // The scan was taken from home: above the place frame at transit height (wall 0.2 + 0.3 m).
-  EXPECT_TRUE(robot.pose.isApprox(HomePose(params, cell), kTol));
-  EXPECT_NEAR(robot.pose.translation().z(), 0.5, kTol);
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
+  EXPECT_NEAR(robot.X_BinTcp.translation().z(), 0.5, kTol);
   ASSERT_EQ(sink.records().size(), 1u);
   const json& end = sink.records()[0];
   EXPECT_EQ(end["type"], "end");
@@ -91,7 +91,7 @@ TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
 }
 
 TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
-  planner.plan_answers.push_back(Plans({MakePlan(4, p_grasp)}, 1));
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   ft.readings = {Reading(0.10), Reading(0.64)};
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
@@ -102,12 +102,12 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_EQ(result.scans, 2u);
 
   // Pre-grasp 0.1 m above, grasp, lift 0.4 m, place, back home.
-  const Eigen::Isometry3d X_grasp = DownPose(p_grasp);
-  EXPECT_TRUE(robot.Visited(DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.1))));
-  EXPECT_TRUE(robot.Visited(X_grasp));
-  EXPECT_TRUE(robot.Visited(DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.4))));
+  const Eigen::Isometry3d X_BinTcpGrasp = DownPose(p_Bin_grasp);
+  EXPECT_TRUE(robot.Visited(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.1))));
+  EXPECT_TRUE(robot.Visited(X_BinTcpGrasp));
+  EXPECT_TRUE(robot.Visited(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4))));
   EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
-  EXPECT_TRUE(robot.pose.isApprox(HomePose(params, cell), kTol));
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
   EXPECT_EQ(gripper.openings, std::vector<double>{0.045});
   EXPECT_TRUE(gripper.open);
 
@@ -118,7 +118,7 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_DOUBLE_EQ(w.reference().force().z(), 0.10);
   EXPECT_DOUBLE_EQ(w.current().force().z(), 0.64);
   EXPECT_DOUBLE_EQ(w.tube_mass(), cell.tube.mass);
-  EXPECT_NEAR(w.tcp_pose().position().z(), p_grasp.z() + 0.4, kTol);
+  EXPECT_NEAR(w.tcp_pose().position().z(), p_Bin_grasp.z() + 0.4, kTol);
 
   const std::vector<json> attempts = Records("attempt");
   ASSERT_EQ(attempts.size(), 1u);
@@ -135,15 +135,15 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_DOUBLE_EQ(a["wrench"]["lift"]["force"][2].get<double>(), 0.64);
   EXPECT_EQ(a["resolution"]["used"], 0);
   EXPECT_EQ(a["result"], "picked");
-  EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_grasp.x());
+  EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_Bin_grasp.x());
   EXPECT_GE(a["durations"]["planning_wall_s"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(a["durations"]["planning_server_s"].get<double>(), 0.5);
   EXPECT_EQ(Records("end").at(0)["picks"], 1);
 }
 
 TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) {
-  const Eigen::Vector3d p_other(-0.2, 0.1, 0.02);
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp), MakePlan(2, p_other)}, 2));
+  const Eigen::Vector3d p_Bin_other(-0.2, 0.1, 0.02);
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp), MakePlan(2, p_Bin_other)}, 2));
   gripper.close_results = {ClosedOnNothing()};
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
@@ -153,7 +153,7 @@ TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) 
   EXPECT_EQ(result.attempts, 2u);
   EXPECT_EQ(planner.plan_requests.size(), 2u);  // the second plan came from the first scan
   EXPECT_EQ(gripper.closes, 2);
-  EXPECT_TRUE(robot.Visited(DownPose(p_other)));
+  EXPECT_TRUE(robot.Visited(DownPose(p_Bin_other)));
 
   const std::vector<json> attempts = Records("attempt");
   ASSERT_EQ(attempts.size(), 2u);
@@ -168,8 +168,8 @@ TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) 
 
 TEST_F(CellControllerTest, NothingGraspedOnTheLastPlanRescans) {
   params.max_plans_per_scan = 1;
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp), MakePlan(2, p_grasp)}, 2));
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp), MakePlan(2, p_Bin_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   gripper.close_results = {ClosedOnNothing()};
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
@@ -186,15 +186,15 @@ TEST_F(CellControllerTest, NothingGraspedOnTheLastPlanRescans) {
 TEST_F(CellControllerTest, PlansTheToolCannotExecuteAreSkipped) {
   // Tube 1 lies 0.25 m from the bin's centre along y: the 0.13 m wide housing would reach 0.315 m,
   // past the +y wall at 0.30 m.
-  const Eigen::Vector3d p_wall(0.0, 0.25, 0.03);
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_wall), MakePlan(2, p_grasp)}, 2));
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_wall)}, 1));
+  const Eigen::Vector3d p_Bin_wall(0.0, 0.25, 0.03);
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_wall), MakePlan(2, p_Bin_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_wall)}, 1));
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.picks, 1u);
   EXPECT_EQ(result.attempts, 1u);
-  EXPECT_FALSE(robot.Visited(DownPose(p_wall)));
+  EXPECT_FALSE(robot.Visited(DownPose(p_Bin_wall)));
   const std::vector<json> records = Records("attempt");
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0]["tube"], 2);
@@ -211,9 +211,9 @@ TEST_F(CellControllerTest, PlansTheToolCannotExecuteAreSkipped) {
 TEST_F(CellControllerTest, PlansBeyondTheRobotsLimitsAreSkipped) {
   // The arm reaches z ≤ 0.35 m: plan 1 lifts 0.4 m, plan 2 only 0.3 m.
   robot.limits.reach_Bin = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -0.1), Eigen::Vector3d(1, 1.2, 0.35));
-  const std::vector<Eigen::Vector3d> short_lift{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)};
-  planner.plan_answers.push_back(
-      Plans({MakePlan(1, p_grasp), MakePlan(2, p_grasp, v1::TRAJECTORY_KIND_UPWARD, short_lift)}, 2));
+  const std::vector<Eigen::Vector3d> short_lift_Bin{Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)};
+  planner.plan_answers.push_back(Plans(
+      {MakePlan(1, p_Bin_grasp), MakePlan(2, p_Bin_grasp, v1::TRAJECTORY_KIND_UPWARD, short_lift_Bin)}, 2));
   planner.plan_answers.push_back(Plans({}, 0));
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
@@ -228,14 +228,14 @@ TEST_F(CellControllerTest, PlansBeyondTheRobotsLimitsAreSkipped) {
   EXPECT_NE(reason.find("out of reach"), std::string::npos) << reason;
   // A tilted wrist beyond the limit is named too.
   devices::RobotLimits limits;
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();  // z_Tcp up: 180° from straight down
-  EXPECT_NE(limits.Problem(X).find("beyond the wrist limit"), std::string::npos);
-  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();  // z down
-  EXPECT_EQ(limits.Problem(X), "");
+  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();  // z_Tcp up: 180° from straight down
+  EXPECT_NE(limits.Problem(X_BinTcp).find("beyond the wrist limit"), std::string::npos);
+  X_BinTcp.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();  // z down
+  EXPECT_EQ(limits.Problem(X_BinTcp), "");
 }
 
 TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 3));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_NONE, 0.05));
 
   const CellRunResult result = Run();
@@ -252,29 +252,29 @@ TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
 
 TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   planner.plan_answers.push_back(
-      Plans({MakePlan(5, p_grasp, v1::TRAJECTORY_KIND_ESCAPE,
+      Plans({MakePlan(5, p_Bin_grasp, v1::TRAJECTORY_KIND_ESCAPE,
                       {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.02), Eigen::Vector3d(0.1, 0, 0.02),
                        Eigen::Vector3d(0.1, 0, 0.42)})},
             4, /*simulated=*/true));
-  const Eigen::Isometry3d X_lift = DownPose(p_grasp + Eigen::Vector3d(0.1, 0, 0.42));
-  Eigen::Isometry3d X_tilted = X_lift;
-  X_tilted.linear() =
-      X_lift.linear() * Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0.1, 0, 0.42));
+  Eigen::Isometry3d X_BinTcpTilted = X_BinTcpLift;
+  X_BinTcpTilted.linear() =
+      X_BinTcpLift.linear() * Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitX()).toRotationMatrix();
   v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.1, 2);
-  AddWaypoint(multiple, 0, X_tilted);
-  AddWaypoint(multiple, 1, X_lift * Eigen::AngleAxisd(-M_PI / 4, Eigen::Vector3d::UnitX()));
+  AddWaypoint(multiple, 0, X_BinTcpTilted);
+  AddWaypoint(multiple, 1, X_BinTcpLift * Eigen::AngleAxisd(-M_PI / 4, Eigen::Vector3d::UnitX()));
   planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_SINGLE, 1.02)};
   ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(0.66)};
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.picks, 1u) << result.message;
-  EXPECT_TRUE(robot.Visited(X_tilted));
+  EXPECT_TRUE(robot.Visited(X_BinTcpTilted));
   // After the rotation the TCP went back to the lift pose, then on to the place pose.
   int tilted_index = -1;
   for (std::size_t i = 0; i < robot.moves.size(); ++i)
-    if (robot.moves[i].target.isApprox(X_tilted, kTol)) tilted_index = static_cast<int>(i);
+    if (robot.moves[i].X_BinTcpTarget.isApprox(X_BinTcpTilted, kTol)) tilted_index = static_cast<int>(i);
   ASSERT_GE(tilted_index, 0);
-  EXPECT_TRUE(robot.moves[tilted_index + 1].target.isApprox(X_lift, kTol));
+  EXPECT_TRUE(robot.moves[tilted_index + 1].X_BinTcpTarget.isApprox(X_BinTcpLift, kTol));
   EXPECT_DOUBLE_EQ(robot.moves[tilted_index].speed, params.resolution_speed);
   EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   // The second analysis used the same reference and the new reading at the lift pose.
@@ -296,11 +296,11 @@ TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
 }
 
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
-  planner.plan_answers.push_back(Plans({MakePlan(5, p_grasp)}, 4));
-  const Eigen::Isometry3d X_lift = DownPose(p_grasp + Eigen::Vector3d(0, 0, 0.4));
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
   v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
-  AddWaypoint(multiple, 0, X_lift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
-  AddWaypoint(multiple, 1, X_lift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
+  AddWaypoint(multiple, 0, X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
+  AddWaypoint(multiple, 1, X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
   planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0),
                             Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9)};
 
@@ -313,7 +313,7 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   bool lowered = false;
   for (const testing::ScriptedRobot::Move& m : robot.moves)
     if (m.through &&
-        m.target.isApprox(DownPose(p_grasp + Eigen::Vector3d(0, 0, params.release_height)), kTol))
+        m.X_BinTcpTarget.isApprox(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height)), kTol))
       lowered = true;
   EXPECT_TRUE(lowered);
   EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
@@ -329,7 +329,7 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
 TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
   params.max_attempts_per_tube = 3;
   params.max_plans_per_scan = 1;
-  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   for (int i = 0; i < 5; ++i) gripper.close_results.push_back(ClosedOnNothing());
 
   const CellRunResult result = Run();
@@ -374,7 +374,7 @@ testing::ScriptedPlanner::PlanAnswer WallTubeWithoutPlan() {
 
 TEST_F(CellControllerTest, TubeAlongAWallWithoutExecutablePlanIsNudgedThenPicked) {
   planner.plan_answers.push_back(WallTubeWithoutPlan());
-  planner.plan_answers.push_back(Plans({MakePlan(0, p_grasp)}, 1));
+  planner.plan_answers.push_back(Plans({MakePlan(0, p_Bin_grasp)}, 1));
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
   const CellRunResult result = Run();
@@ -401,8 +401,8 @@ TEST_F(CellControllerTest, TubeAlongAWallWithoutExecutablePlanIsNudgedThenPicked
   // The robot pressed at the planned pose and pushed along +y by the planned distance.
   bool pushed = false;
   for (const testing::ScriptedRobot::Move& m : robot.moves) {
-    if (m.through && m.waypoints.size() == 2 &&
-        m.waypoints.back().isApprox(Eigen::Vector3d(0.0, distance, 0.0), 1e-12)) {
+    if (m.through && m.waypoints_Bin.size() == 2 &&
+        m.waypoints_Bin.back().isApprox(Eigen::Vector3d(0.0, distance, 0.0), 1e-12)) {
       pushed = true;
       EXPECT_DOUBLE_EQ(m.speed, params.nudge.speed);
     }
@@ -460,7 +460,7 @@ TEST_F(CellControllerTest, RobotFaultDuringANudgeEndsInSafeStopAndIsRecorded) {
 TEST_F(CellControllerTest, PerBinLimitCountsAllAttempts) {
   params.max_attempts_per_bin = 2;
   for (int i = 0; i < 3; ++i) {
-    planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 3));
+    planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
     planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
   }
   const CellRunResult result = Run();
@@ -493,7 +493,7 @@ TEST_F(CellControllerTest, ScannerTimeoutEndsInSafeStop) {
 }
 
 TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   devices::GripperStatus fault;
   fault.activated = true;
   fault.fault = 0x08;
@@ -511,8 +511,8 @@ TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) 
   EXPECT_EQ(gripper.opens, opens_before_stop + 1);
   EXPECT_TRUE(gripper.open);
   // The robot was at the grasp pose in the bin; the safe stop moved it straight up to transit height.
-  EXPECT_NEAR(robot.pose.translation().z(), 0.5, kTol);
-  EXPECT_NEAR(robot.pose.translation().x(), p_grasp.x(), kTol);
+  EXPECT_NEAR(robot.X_BinTcp.translation().z(), 0.5, kTol);
+  EXPECT_NEAR(robot.X_BinTcp.translation().x(), p_Bin_grasp.x(), kTol);
   EXPECT_NE(result.message.find("robot moved up to z = 0.500 m"), std::string::npos) << result.message;
   const json a = Records("attempt").at(0);
   EXPECT_EQ(a["result"], "fault");
@@ -521,7 +521,7 @@ TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) 
 }
 
 TEST_F(CellControllerTest, RobotFaultDuringLiftEndsInSafeStopEvenWhenTheRobotCannotMove) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   robot.fail_through_from = 0;
 
   const CellRunResult result = Run();
@@ -539,7 +539,7 @@ TEST_F(CellControllerTest, RobotFaultDuringLiftEndsInSafeStopEvenWhenTheRobotCan
 }
 
 TEST_F(CellControllerTest, ForceTorqueTimeoutAfterLiftEndsInSafeStop) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   ft.fail_read_from = 1;  // the reference works, the reading after the lift does not
 
   const CellRunResult result = Run();
@@ -590,7 +590,7 @@ TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
 }
 
 TEST_F(CellControllerTest, SafeStopSaysSoWhenTheGripperCannotOpen) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   robot.fail_through_from = 0;
   gripper.fail_open_from = 1;  // the start's open works
 
@@ -604,7 +604,7 @@ TEST_F(CellControllerTest, SafeStopSaysSoWhenTheGripperCannotOpen) {
 }
 
 TEST_F(CellControllerTest, UnusablePlanIsAServerError) {
-  v1::PickPlan plan = MakePlan(1, p_grasp);
+  v1::PickPlan plan = MakePlan(1, p_Bin_grasp);
   plan.clear_waypoints();
   planner.plan_answers.push_back(Plans({plan}, 1));
   const CellRunResult result = Run();

@@ -43,17 +43,17 @@ TEST_F(NudgeTest, TubeAlongTheMinusYWallIsPushedStraightOffIt) {
   // push_gain · (0.15 − 0.0235) = 0.253, clamped to max_push.
   EXPECT_NEAR(plan->distance, params.max_push, 1e-12);
   // The closed, tilted tool clears the wall and the floor at the press, along the push and up.
-  EXPECT_FALSE(ToolClearanceProblem(cell, tool, plan->X_BinTcp_press, 0.0,
+  EXPECT_FALSE(ToolClearanceProblem(cell, tool, plan->X_BinTcpPress, 0.0,
                                     {Eigen::Vector3d::Zero(), plan->distance * plan->direction,
                                      plan->distance * plan->direction + Eigen::Vector3d(0, 0, 0.1)}));
   // x_Tcp along the push (the housing's narrow side faces the wall), z_Tcp down and towards the
   // wall by the tilt.
-  const Eigen::Matrix3d R = plan->X_BinTcp_press.linear();
+  const Eigen::Matrix3d R = plan->X_BinTcpPress.linear();
   EXPECT_NEAR(R.col(2).z(), -std::cos(params.tilt), 1e-9);
   EXPECT_NEAR(R.col(2).y(), -std::sin(params.tilt), 1e-9);
   EXPECT_TRUE(R.col(1).isApprox(Eigen::Vector3d::UnitX(), 1e-12));  // closing along the wall
   // The pads' bottom is press_depth below the tube's top, and the pads still cover it.
-  const Eigen::Vector3d tip = plan->X_BinTcp_press * Eigen::Vector3d(0, 0, tool.finger_tip_depth);
+  const Eigen::Vector3d tip = plan->X_BinTcpPress * Eigen::Vector3d(0, 0, tool.finger_tip_depth);
   EXPECT_NEAR(tip.z(), 2.0 * kR - params.press_depth, 1e-9);
   EXPECT_LE(plan->shift, 0.5 * tool.finger_size.x() + 0.5 * kR + 1e-9);
   // Further tries push elsewhere along the tube: 0.3 and 0.7 of its length.

@@ -12,11 +12,11 @@
 #include <Eigen/Geometry>
 
 #include "clients/cell/planner_client.h"
-#include "wire/proto_convert.h"
 #include "devices/force_torque_sensor.h"
 #include "devices/gripper.h"
 #include "devices/robot.h"
 #include "devices/scanner.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::cell::testing {
 
@@ -50,11 +50,14 @@ class ScriptedRobot final : public devices::Robot {
  public:
   struct Move {
     bool through = false;  ///< MoveThrough (else MoveTo)
-    Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
-    std::vector<Eigen::Vector3d> waypoints;
+    /// Where the TCP ended up.
+    Eigen::Isometry3d X_BinTcpTarget = Eigen::Isometry3d::Identity();
+    /// MoveThrough's TCP translations, bin axes.
+    std::vector<Eigen::Vector3d> waypoints_Bin;
     double speed = 0.0;
   };
-  Eigen::Isometry3d pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 1.0));
+  /// The TCP in the bin frame.
+  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 1.0));
   std::vector<Move> moves;
   bool servo_on = false;
   /// Fails every MoveThrough from the n-th on (0-based), or every motion when fail_always.
@@ -63,31 +66,32 @@ class ScriptedRobot final : public devices::Robot {
   Failure failure{false, "YRC1000 alarm 4107: out of range (joint T)"};
   int throughs = 0;
 
-  void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, devices::Timeout) override {
+  void MoveTo(const Eigen::Isometry3d& X_BinTcpTarget, double speed, devices::Timeout) override {
     if (fail_always) failure.Throw();
-    moves.push_back({false, X_BinTcp, {}, speed});
-    pose = X_BinTcp;
+    moves.push_back({false, X_BinTcpTarget, {}, speed});
+    X_BinTcp = X_BinTcpTarget;
   }
   devices::RobotLimits limits;
   devices::RobotLimits Limits() const override { return limits; }
-  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, devices::Timeout) override {
+  void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed,
+                   devices::Timeout) override {
     const int i = throughs++;
     if (fail_always || (fail_through_from && i >= *fail_through_from)) {
       fail_always = true;  // a robot in alarm refuses every further motion
       failure.Throw();
     }
-    Eigen::Isometry3d target = pose;
-    target.translation() += waypoints.back();
-    moves.push_back({true, target, waypoints, speed});
-    pose = target;
+    Eigen::Isometry3d X_BinTcpTarget = X_BinTcp;
+    X_BinTcpTarget.translation() += waypoints_Bin.back();
+    moves.push_back({true, X_BinTcpTarget, waypoints_Bin, speed});
+    X_BinTcp = X_BinTcpTarget;
   }
-  Eigen::Isometry3d CurrentPose(devices::Timeout) override { return pose; }
+  Eigen::Isometry3d CurrentPose(devices::Timeout) override { return X_BinTcp; }
   void ServoOn(devices::Timeout) override { servo_on = true; }
 
-  /// Whether some MoveTo / MoveThrough ended at `X` (within 1e-9).
-  bool Visited(const Eigen::Isometry3d& X) const {
+  /// Whether some MoveTo / MoveThrough ended at `X_BinTcpVisited` (within 1e-9).
+  bool Visited(const Eigen::Isometry3d& X_BinTcpVisited) const {
     for (const Move& m : moves)
-      if (m.target.isApprox(X, 1e-9)) return true;
+      if (m.X_BinTcpTarget.isApprox(X_BinTcpVisited, 1e-9)) return true;
     return false;
   }
 };
@@ -193,28 +197,32 @@ class ScriptedPlanner final : public PlannerClient {
   }
 };
 
-/// TCP pointing down (z_Tcp = -z_Bin) at `p`.
-inline Eigen::Isometry3d DownPose(const Eigen::Vector3d& p) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  X.translation() = p;
-  return X;
+/// X_BinTcp: the TCP pointing down (z_Tcp = -z_Bin) at `p_Bin_tcp`.
+inline Eigen::Isometry3d DownPose(const Eigen::Vector3d& p_Bin_tcp) {
+  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
+  X_BinTcp.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  X_BinTcp.translation() = p_Bin_tcp;
+  return X_BinTcp;
 }
 
-/// A plan for `tube` grasped at `p_grasp`, lifted along `waypoints` (default straight up 0.4 m).
-inline v1::PickPlan MakePlan(std::uint32_t tube, const Eigen::Vector3d& p_grasp,
+/// The place pose MakePlan gives every plan.
+inline Eigen::Isometry3d PlacePose() { return DownPose(Eigen::Vector3d(0.0, 0.8, 0.12)); }
+
+/// A plan for `tube` grasped at `p_Bin_grasp` (DownPose), lifted along `waypoints_Bin` (TCP
+/// translations from the grasp pose; default straight up 0.4 m), placed at PlacePose().
+inline v1::PickPlan MakePlan(std::uint32_t tube, const Eigen::Vector3d& p_Bin_grasp,
                              v1::TrajectoryKind kind = v1::TRAJECTORY_KIND_UPWARD,
-                             std::vector<Eigen::Vector3d> waypoints = {Eigen::Vector3d::Zero(),
-                                                                       Eigen::Vector3d(0, 0, 0.4)}) {
+                             std::vector<Eigen::Vector3d> waypoints_Bin = {Eigen::Vector3d::Zero(),
+                                                                           Eigen::Vector3d(0, 0, 0.4)}) {
   v1::PickPlan plan;
   plan.set_tube_id(tube);
-  *plan.mutable_grasp()->mutable_tcp_pose() = ToProto(DownPose(p_grasp));
+  *plan.mutable_grasp()->mutable_tcp_pose() = ToProto(DownPose(p_Bin_grasp));
   *plan.mutable_grasp()->mutable_approach() = ToProto(Eigen::Vector3d(0, 0, -1));
   plan.mutable_grasp()->set_opening_width(0.045);
-  for (const Eigen::Vector3d& w : waypoints) *plan.add_waypoints() = ToProto(w);
+  for (const Eigen::Vector3d& w : waypoints_Bin) *plan.add_waypoints() = ToProto(w);
   plan.set_trajectory_kind(kind);
   plan.mutable_cost()->set_total(0.1 * tube);
-  *plan.mutable_place_tcp_pose() = ToProto(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12)));
+  *plan.mutable_place_tcp_pose() = ToProto(PlacePose());
   return plan;
 }
 

@@ -6,12 +6,12 @@ namespace tubepick::cell {
 namespace {
 
 Eigen::Isometry3d Down(double x, double y, double z, double yaw = 0.0) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() =
+  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
+  X_BinTcp.linear() =
       (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
-  X.translation() = Eigen::Vector3d(x, y, z);
-  return X;
+  X_BinTcp.translation() = Eigen::Vector3d(x, y, z);
+  return X_BinTcp;
 }
 
 class ToolClearanceTest : public ::testing::Test {

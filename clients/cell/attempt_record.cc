@@ -1,0 +1,113 @@
+#include "clients/cell/attempt_record.h"
+
+#include "clients/cell/cell_records.h"
+#include "wire/proto_convert.h"
+
+namespace tubepick::cell {
+
+nlohmann::json AttemptRecord(const AttemptRecordHead& head, const v1::PlanPickResponse& response) {
+  return nlohmann::json{{"type", "attempt"},
+                        {"round", head.round},
+                        {"attempt", head.attempt},
+                        {"scan", head.scan},
+                        {"plan_rank", head.plan_rank},
+                        {"seed", head.seed},
+                        {"tubes_left_plan", response.tubes_size()},
+                        {"plans", response.plans_size()},
+                        {"bin_empty", response.bin_empty()},
+                        {"used_simulation", response.used_simulation()},
+                        {"truth_before", head.truth_before}};
+}
+
+nlohmann::json PlanningDurationsJson(double planning_wall_s, double planning_server_s) {
+  return {{"planning_wall_s", planning_wall_s}, {"planning_server_s", planning_server_s}};
+}
+
+void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan) {
+  record["tube"] = plan.tube_id();
+  record["trajectory_kind"] = TrajectoryKindName(plan.trajectory_kind());
+  record["cost"] = {{"height", plan.cost().height()},
+                    {"centre", plan.cost().centre()},
+                    {"trajectory", plan.cost().trajectory()},
+                    {"total", plan.cost().total()}};
+  record["simulated_displacement"] = plan.simulated_displacement();
+}
+
+nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& reason) {
+  return {{"rank", rank}, {"tube", tube}, {"reason", reason}};
+}
+
+nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
+                         double opening_width) {
+  return {{"tcp_pose", PoseJson(X_BinTcpGrasp)},
+          {"approach", VectorJson(approach_Bin)},
+          {"opening_width", opening_width}};
+}
+
+nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis) {
+  return {{"outcome", HeldOutcomeName(analysis.outcome())},
+          {"estimated_count", analysis.estimated_count()},
+          {"tube_ratio", analysis.tube_ratio()},
+          {"held_weight", analysis.held_weight()},
+          {"tube_weight", analysis.tube_weight()},
+          {"motions", analysis.resolution_motions_size()}};
+}
+
+nlohmann::json ResolutionJson(int available) {
+  return {{"available", available}, {"used", 0}, {"succeeded", false}};
+}
+
+nlohmann::json AfterResolutionJson(int m, const v1::ResolutionMotion& motion,
+                                   const devices::WrenchReading& wrench,
+                                   const v1::AnalyzeWrenchResponse& analysis) {
+  return {{"motion", m},
+          {"description", motion.description()},
+          {"wrench", WrenchJson(wrench)},
+          {"outcome", HeldOutcomeName(analysis.outcome())},
+          {"tube_ratio", analysis.tube_ratio()}};
+}
+
+nlohmann::json NudgeJson(const NudgePlan& nudge) {
+  return {{"tube", nudge.tube_id},
+          {"contact", VectorJson(nudge.p_Bin_contact)},
+          {"wall_distance", nudge.wall_distance},
+          {"direction", VectorJson(nudge.direction)},
+          {"shift", nudge.shift},
+          {"distance", nudge.distance},
+          {"tcp_pose", PoseJson(nudge.X_BinTcpPress)}};
+}
+
+nlohmann::json FaultJson(const CellFault& fault) {
+  return {{"device", fault.device()},
+          {"kind", ToString(fault.kind())},
+          {"state", fault.state()},
+          {"error", fault.error()}};
+}
+
+nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result) {
+  return {{"type", "safe_stop"},
+          {"round", round},
+          {"device", fault.device()},
+          {"kind", ToString(fault.kind())},
+          {"state", fault.state()},
+          {"error", fault.error()},
+          {"gripper_opened", result.gripper_opened},
+          {"moved_up", result.moved_up},
+          {"message", result.message}};
+}
+
+nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const nlohmann::json& truth_start,
+                         const nlohmann::json& truth) {
+  return {{"type", "end"},
+          {"round", round},
+          {"reason", ToString(result.reason)},
+          {"message", result.message},
+          {"picks", result.picks},
+          {"attempts", result.attempts},
+          {"scans", result.scans},
+          {"nudges", result.nudges},
+          {"truth_start", truth_start},
+          {"truth", truth}};
+}
+
+}  // namespace tubepick::cell

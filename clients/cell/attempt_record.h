@@ -1,0 +1,72 @@
+#pragma once
+
+// The parts of the controller's records (fields listed in clients/cell/cell_controller.h and
+// docs/): built here so that the state machine only says which part it records when.
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_fault.h"
+#include "clients/cell/nudge.h"
+#include "devices/force_torque_sensor.h"
+#include "tubepick/v1/planning.pb.h"
+
+namespace tubepick::cell {
+
+/// What an attempt record's common fields come from.
+struct AttemptRecordHead {
+  std::uint32_t round = 0;
+  /// The attempt's number in the run (null for a scan without an attempt: set by the caller).
+  std::uint32_t attempt = 0;
+  std::uint32_t scan = 0;
+  std::uint32_t plan_rank = 0;
+  std::uint64_t seed = 0;
+  nlohmann::json truth_before;
+};
+
+/// {"type": "attempt", round, attempt, scan, plan_rank, seed, tubes_left_plan, plans, bin_empty,
+/// used_simulation, truth_before}.
+nlohmann::json AttemptRecord(const AttemptRecordHead& head, const v1::PlanPickResponse& response);
+
+/// {durations: {planning_wall_s, planning_server_s}}'s value.
+nlohmann::json PlanningDurationsJson(double planning_wall_s, double planning_server_s);
+
+/// Adds the plan's tube, trajectory_kind, cost and simulated_displacement to `record`.
+void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan);
+
+/// {"rank", "tube", "reason"}: one entry of skipped_plans.
+nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& reason);
+
+/// {"tcp_pose", "approach", "opening_width"}.
+nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
+                         double opening_width);
+
+/// {"outcome", "estimated_count", "tube_ratio", "held_weight", "tube_weight", "motions"}.
+nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis);
+
+/// {"available", "used": 0, "succeeded": false}.
+nlohmann::json ResolutionJson(int available);
+
+/// One entry of wrench.after_resolution: {"motion", "description", "wrench", "outcome", "tube_ratio"}.
+nlohmann::json AfterResolutionJson(int m, const v1::ResolutionMotion& motion,
+                                   const devices::WrenchReading& wrench,
+                                   const v1::AnalyzeWrenchResponse& analysis);
+
+/// {"tube", "contact", "wall_distance", "direction", "shift", "distance", "tcp_pose"}.
+nlohmann::json NudgeJson(const NudgePlan& nudge);
+
+/// {"device", "kind", "state", "error"}.
+nlohmann::json FaultJson(const CellFault& fault);
+
+/// {"type": "safe_stop", round, device, kind, state, error, gripper_opened, moved_up, message}.
+nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result);
+
+/// {"type": "end", round, reason, message, picks, attempts, scans, nudges, truth_start, truth}.
+nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const nlohmann::json& truth_start,
+                         const nlohmann::json& truth);
+
+}  // namespace tubepick::cell

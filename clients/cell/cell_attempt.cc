@@ -1,0 +1,274 @@
+// One picking attempt of the cell controller, step by step: approach → reference → grasp → lift →
+// analyze → place | release | resolve → place | release | put back; and the nudge's motions.
+// Poses are X_BinTcp…: the TCP in the bin frame.
+
+#include <fmt/core.h>
+
+#include "clients/cell/attempt_record.h"
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/tool_clearance.h"
+#include "wire/proto_convert.h"
+
+namespace tubepick::cell {
+namespace {
+
+/// The plan's unit approach direction (bin axes); the TCP's z axis when the plan gives none.
+Eigen::Vector3d ApproachOf(const v1::PickPlan& plan, const Eigen::Isometry3d& X_BinTcpGrasp) {
+  Eigen::Vector3d approach_Bin = FromProto(plan.grasp().approach());
+  if (!approach_Bin.allFinite() || approach_Bin.norm() < 1e-9) approach_Bin = X_BinTcpGrasp.linear().col(2);
+  return approach_Bin.normalized();
+}
+
+/// The grasp pose backed off `height` against the approach direction.
+Eigen::Isometry3d PreGraspPose(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
+                               double height) {
+  Eigen::Isometry3d X_BinTcpPreGrasp = X_BinTcpGrasp;
+  X_BinTcpPreGrasp.translation() -= height * approach_Bin;
+  return X_BinTcpPreGrasp;
+}
+
+/// The plan's lift waypoints: TCP translations from the grasp pose, bin axes.
+std::vector<Eigen::Vector3d> WaypointsOf(const v1::PickPlan& plan) {
+  std::vector<Eigen::Vector3d> waypoints_Bin;
+  for (const v1::Vector3& w : plan.waypoints()) waypoints_Bin.push_back(FromProto(w));
+  return waypoints_Bin;
+}
+
+}  // namespace
+
+using detail::CallDevice;
+using detail::PlannerPose;
+
+// ---------------------------------------------------------------- plan
+
+std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& plan, int rank) const {
+  const Eigen::Isometry3d X_BinTcpGrasp =
+      PlannerPose(plan.grasp().tcp_pose(), fmt::format("plans[{}].grasp.tcp_pose", rank), state_);
+  const std::vector<Eigen::Vector3d> waypoints_Bin = WaypointsOf(plan);
+  // The arm's reach and wrist limits: pre-grasp, grasp, every lift waypoint and the placement.
+  const devices::RobotLimits limits = devices_.robot->Limits();
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> X_BinTcp_checked;
+  X_BinTcp_checked.emplace_back(
+      "pre-grasp", PreGraspPose(X_BinTcpGrasp, ApproachOf(plan, X_BinTcpGrasp), params_.approach_height));
+  X_BinTcp_checked.emplace_back("grasp", X_BinTcpGrasp);
+  for (std::size_t i = 0; i < waypoints_Bin.size(); ++i) {
+    Eigen::Isometry3d X_BinTcpWaypoint = X_BinTcpGrasp;
+    X_BinTcpWaypoint.translation() += waypoints_Bin[i];
+    X_BinTcp_checked.emplace_back(fmt::format("waypoint {}", i), X_BinTcpWaypoint);
+  }
+  if (plan.has_place_tcp_pose())
+    X_BinTcp_checked.emplace_back(
+        "place", PlannerPose(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank), state_));
+  for (const auto& [what, X_BinTcp] : X_BinTcp_checked) {
+    const std::string problem = limits.Problem(X_BinTcp);
+    if (!problem.empty()) return fmt::format("robot limits at the {}: {}", what, problem);
+  }
+  if (!params_.check_tool_clearance) return std::nullopt;
+  return ToolClearanceProblem(cell_, params_.tool, X_BinTcpGrasp, plan.grasp().opening_width(),
+                              waypoints_Bin);
+}
+
+CellController::PlanPoses CellController::PosesOf(const v1::PickPlan& plan, int rank) const {
+  const std::string field = fmt::format("plans[{}]", rank);
+  PlanPoses poses;
+  poses.X_BinTcpGrasp = PlannerPose(plan.grasp().tcp_pose(), field + ".grasp.tcp_pose", CellState::kPlan);
+  poses.X_BinTcpPlace = PlannerPose(plan.place_tcp_pose(), field + ".place_tcp_pose", CellState::kPlan);
+  if (plan.waypoints_size() == 0)
+    throw CellFault("planner", FaultKind::kServerError, ToString(CellState::kPlan),
+                    field + ".waypoints: empty (a trajectory starts with (0, 0, 0))");
+  poses.approach_Bin = ApproachOf(plan, poses.X_BinTcpGrasp);
+  poses.X_BinTcpPreGrasp = PreGraspPose(poses.X_BinTcpGrasp, poses.approach_Bin, params_.approach_height);
+  poses.waypoints_Bin = WaypointsOf(plan);
+  return poses;
+}
+
+// ---------------------------------------------------------------- attempt
+
+void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& attempt) {
+  RecordPlan(attempt.record, plan);
+  const PlanPoses poses = PosesOf(plan, rank);
+  const double opening_width = plan.grasp().opening_width();
+  attempt.record["grasp"] = GraspJson(poses.X_BinTcpGrasp, poses.approach_Bin, opening_width);
+
+  Approach(poses.X_BinTcpPreGrasp, opening_width, attempt);
+  const devices::WrenchReading reference = TakeReference(attempt);
+  if (!Grasp(poses.X_BinTcpGrasp, attempt)) {
+    ReleaseFailedGrasp(poses.X_BinTcpPreGrasp, attempt);
+    attempt.result = AttemptResult::kGraspFailed;
+    return;
+  }
+  const Eigen::Isometry3d X_BinTcpLift = Lift(poses.waypoints_Bin, attempt);
+  const v1::AnalyzeWrenchResponse analysis = AnalyzeLift(reference, X_BinTcpLift, attempt);
+  attempt.result = Conclude(analysis.outcome(), poses.X_BinTcpPlace, attempt);
+  if (!attempt.result) attempt.result = Resolve(analysis, reference, poses, X_BinTcpLift, attempt);
+}
+
+/// Transit to the pre-grasp pose, open to the grasp width.
+void CellController::Approach(const Eigen::Isometry3d& X_BinTcpPreGrasp, double opening_width,
+                              Attempt& attempt) {
+  Enter(CellState::kApproach);
+  TransitTo(X_BinTcpPreGrasp, &attempt);
+  if (opening_width > 0.0) {
+    CheckGripper(CallDevice("gripper", state_, [&] {
+      return devices_.gripper->MoveTo(opening_width, params_.gripper_speed, params_.gripper_force,
+                                      params_.gripper_timeout);
+    }));
+  }
+}
+
+/// The F/T reference: the gripper is empty and already in the orientation of the lift.
+devices::WrenchReading CellController::TakeReference(Attempt& attempt) {
+  Enter(CellState::kReference);
+  const devices::WrenchReading reference = ReadWrench();
+  attempt.record["wrench"] = {{"reference", WrenchJson(reference)}};
+  return reference;
+}
+
+bool CellController::Grasp(const Eigen::Isometry3d& X_BinTcpGrasp, Attempt& attempt) {
+  Enter(CellState::kGrasp);
+  MoveTo(X_BinTcpGrasp, params_.approach_speed, &attempt);
+  const devices::GripperStatus closed = CloseGripper();
+  attempt.record["gripper"] = GripperJson(closed);
+  return closed.object == devices::GripperObject::kStoppedClosing;
+}
+
+/// Nothing grasped: open, back up to the pre-grasp pose, home.
+void CellController::ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpPreGrasp, Attempt& attempt) {
+  Enter(CellState::kRelease);
+  OpenGripper();
+  MoveTo(X_BinTcpPreGrasp, params_.approach_speed, &attempt);
+  GoHome(&attempt);
+}
+
+Eigen::Isometry3d CellController::Lift(const std::vector<Eigen::Vector3d>& waypoints_Bin, Attempt& attempt) {
+  Enter(CellState::kLift);
+  MoveThrough(waypoints_Bin, params_.lift_speed, &attempt);
+  return CurrentPose();
+}
+
+/// A reading at the lift pose and its analysis against the reference.
+v1::AnalyzeWrenchResponse CellController::AnalyzeLift(const devices::WrenchReading& reference,
+                                                      const Eigen::Isometry3d& X_BinTcpLift,
+                                                      Attempt& attempt) {
+  Enter(CellState::kAnalyze);
+  nlohmann::json& record = attempt.record;
+  const devices::WrenchReading lifted = ReadWrench();
+  record["wrench"]["lift"] = WrenchJson(lifted);
+  record["wrench"]["after_resolution"] = nlohmann::json::array();
+  const v1::AnalyzeWrenchResponse analysis = Analyze(reference, lifted, X_BinTcpLift, attempt);
+  record["analysis"] = AnalysisJson(analysis);
+  record["resolution"] = ResolutionJson(analysis.resolution_motions_size());
+  return analysis;
+}
+
+std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOutcome outcome,
+                                                                      const Eigen::Isometry3d& X_BinTcpPlace,
+                                                                      Attempt& attempt) {
+  switch (outcome) {
+    case v1::HELD_OUTCOME_SINGLE:
+      Place(X_BinTcpPlace, attempt);
+      return AttemptResult::kPicked;
+    case v1::HELD_OUTCOME_NONE:
+      ReleaseEmpty(attempt);
+      return AttemptResult::kNone;
+    default:
+      return std::nullopt;
+  }
+}
+
+/// Several tubes: resolution motions in order, each followed by a new reading at the lift pose.
+CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchResponse& analysis,
+                                                      const devices::WrenchReading& reference,
+                                                      const PlanPoses& poses,
+                                                      const Eigen::Isometry3d& X_BinTcpLift,
+                                                      Attempt& attempt) {
+  Enter(CellState::kResolve);
+  nlohmann::json& resolution = attempt.record["resolution"];
+  for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
+    resolution["used"] = m + 1;
+    const v1::AnalyzeWrenchResponse again =
+        ResolutionMotion(analysis.resolution_motions(m), m, reference, X_BinTcpLift, attempt);
+    if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
+    if (const std::optional<AttemptResult> result = Conclude(again.outcome(), poses.X_BinTcpPlace, attempt))
+      return *result;
+  }
+  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, attempt);
+  return AttemptResult::kMultipleReturned;
+}
+
+v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionMotion& motion, int m,
+                                                           const devices::WrenchReading& reference,
+                                                           const Eigen::Isometry3d& X_BinTcpLift,
+                                                           Attempt& attempt) {
+  for (int w = 0; w < motion.waypoints_size(); ++w) {
+    const Eigen::Isometry3d X_BinTcpWaypoint =
+        PlannerPose(motion.waypoints(w).tcp_pose(),
+                    fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
+    MoveTo(X_BinTcpWaypoint, params_.resolution_speed, &attempt);
+  }
+  MoveTo(X_BinTcpLift, params_.resolution_speed, &attempt);
+  const devices::WrenchReading after = ReadWrench();
+  const v1::AnalyzeWrenchResponse again = Analyze(reference, after, X_BinTcpLift, attempt);
+  attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, after, again));
+  return again;
+}
+
+// ---------------------------------------------------------------- endings
+
+/// One tube held: transit above the place pose, down, open, up, home.
+void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, Attempt& attempt) {
+  Enter(CellState::kPlace);
+  Eigen::Isometry3d X_BinTcpAbovePlace = X_BinTcpPlace;
+  X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
+  TransitTo(X_BinTcpAbovePlace, &attempt);
+  MoveTo(X_BinTcpPlace, params_.approach_speed, &attempt);
+  OpenGripper();
+  MoveTo(X_BinTcpAbovePlace, params_.approach_speed, &attempt);
+  GoHome(&attempt);
+}
+
+/// Nothing held after the lift: open where the gripper is, home.
+void CellController::ReleaseEmpty(Attempt& attempt) {
+  Enter(CellState::kRelease);
+  OpenGripper();
+  GoHome(&attempt);
+}
+
+void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
+                             Attempt& attempt) {
+  Enter(CellState::kReturnToBin);
+  // Straight down from the lift pose (its xy was checked against the bin's safety zone by the
+  // planner) to just above the grasp height, open, and back up.
+  const double drop =
+      X_BinTcpGrasp.translation().z() + params_.release_height - X_BinTcpLift.translation().z();
+  if (drop < 0.0)
+    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, drop)}, params_.lift_speed, &attempt);
+  OpenGripper();
+  if (drop < 0.0)
+    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -drop)}, params_.approach_speed, &attempt);
+  GoHome(&attempt);
+}
+
+void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {
+  Enter(CellState::kNudge);
+  // Closed pads (nothing between them: the gripper is at home) make one narrow block.
+  CloseGripper();
+  Eigen::Isometry3d X_BinTcpAbovePress = plan.X_BinTcpPress;
+  X_BinTcpAbovePress.translation().z() += params_.approach_height;
+  TransitTo(X_BinTcpAbovePress, &attempt);
+  MoveTo(plan.X_BinTcpPress, params_.approach_speed, &attempt);
+  MoveThrough(NudgePushWaypoints(plan), params_.nudge.speed, &attempt);
+  MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, params_.approach_height)},
+              params_.approach_speed, &attempt);
+  OpenGripper();
+  GoHome(&attempt);
+}
+
+void CellController::GoHome(Attempt* attempt) {
+  Enter(CellState::kHome);
+  const Eigen::Isometry3d X_BinHome = HomePose(params_, cell_);
+  TransitTo(X_BinHome, attempt);
+}
+
+}  // namespace tubepick::cell

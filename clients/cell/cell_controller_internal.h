@@ -1,0 +1,112 @@
+#pragma once
+
+// What the controller's source files share (cell_controller.cc, cell_attempt.cc,
+// cell_device_calls.cc): the state of a run, a scan and an attempt, and the device and planner call
+// wrappers that turn failures into CellFault. Not for use outside the controller.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "clients/cell/cell_controller.h"
+
+namespace tubepick::cell {
+
+namespace detail {
+
+using Clock = std::chrono::steady_clock;
+
+inline double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Runs a device call; its DeviceTimeout / DeviceFault become a CellFault naming the device.
+template <typename F>
+auto CallDevice(const char* device, CellState state, F&& call) -> decltype(call()) {
+  try {
+    return call();
+  } catch (const devices::DeviceTimeout& e) {
+    throw CellFault(device, FaultKind::kTimeout, ToString(state), e.what());
+  } catch (const devices::DeviceFault& e) {
+    throw CellFault(device, FaultKind::kDeviceFault, ToString(state), e.what());
+  }
+}
+
+/// Runs a planner call; a PlannerError becomes a CellFault.
+template <typename F>
+auto CallPlanner(CellState state, F&& call) -> decltype(call()) {
+  try {
+    return call();
+  } catch (const PlannerError& e) {
+    const bool unavailable = e.code() == grpc::StatusCode::UNAVAILABLE ||
+                             e.code() == grpc::StatusCode::RESOURCE_EXHAUSTED ||
+                             e.code() == grpc::StatusCode::DEADLINE_EXCEEDED;
+    throw CellFault("planner", unavailable ? FaultKind::kServerUnavailable : FaultKind::kServerError,
+                    ToString(state), e.what());
+  }
+}
+
+/// A pose the planner sent, bin frame; an unusable one is a planner fault in `state`.
+Eigen::Isometry3d PlannerPose(const v1::Pose& pose, const std::string& field, CellState state);
+
+/// `X` moved vertically to height `z` (bin frame).
+inline Eigen::Isometry3d WithHeight(Eigen::Isometry3d X, double z) {
+  X.translation().z() = z;
+  return X;
+}
+
+constexpr double kSameHeight = 1e-4;  // m: moves shorter than this are skipped
+
+}  // namespace detail
+
+/// One picking attempt (or nudge) under way: its record and its running durations.
+struct CellController::Attempt {
+  nlohmann::json record;
+  double robot_wall_s = 0.0;
+  double robot_device_s = 0.0;
+  double analysis_wall_s = 0.0;
+  detail::Clock::time_point started = detail::Clock::now();
+  double device_started = 0.0;
+  std::optional<AttemptResult> result;
+};
+
+/// One run (one bin): its result so far, the counters the attempt limits look at and the attempt
+/// under way (recorded as "fault" when a fault stops the run).
+struct CellController::RunState {
+  CellRunResult result;
+  std::uint32_t attempts_since_pick = 0;
+  std::uint32_t consecutive_failures = 0;
+  std::uint32_t nudges_since_pick = 0;
+  std::optional<Attempt> active;
+};
+
+/// One scan and the planner's answer to it; its time counts towards the scan's first attempt.
+struct CellController::PlannedScan {
+  std::uint32_t index = 0;  ///< scans before this one in the run
+  nlohmann::json truth_before;
+  detail::Clock::time_point started;
+  double device_started = 0.0;
+  v1::PlanPickResponse response;
+  double planning_wall_s = 0.0;
+  /// Plans skipped since the last attempt (rank, tube, reason), for the next record.
+  nlohmann::json skipped = nlohmann::json::array();
+};
+
+/// The TCP poses of one plan, bin frame.
+struct CellController::PlanPoses {
+  Eigen::Isometry3d X_BinTcpGrasp = Eigen::Isometry3d::Identity();
+  /// X_BinTcpGrasp backed off params.approach_height against the approach direction.
+  Eigen::Isometry3d X_BinTcpPreGrasp = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d X_BinTcpPlace = Eigen::Isometry3d::Identity();
+  /// Unit approach direction, bin axes (the TCP's z axis when the plan gives none).
+  Eigen::Vector3d approach_Bin = Eigen::Vector3d::UnitZ();
+  /// The lift: TCP translations from the grasp pose, bin axes (the first is (0, 0, 0)).
+  std::vector<Eigen::Vector3d> waypoints_Bin;
+};
+
+}  // namespace tubepick::cell
