@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 #include "core/common/yaml_reader.h"
 
 namespace tubepick::server {

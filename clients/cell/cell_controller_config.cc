@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 #include "core/common/yaml_reader.h"
 
 namespace tubepick::cell {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 #include "core/common/yaml_reader.h"
 
 namespace tubepick {

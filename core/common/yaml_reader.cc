@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
+
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {
@@ -52,6 +55,17 @@ void YamlMap::Read(const std::string& key, double& value) {
 
 void YamlMap::Read(const std::string& key, bool& value) {
   if (const auto n = Get(key)) value = Convert<bool>(*n, PathOf(key), "true or false");
+}
+
+void YamlMap::Read(const std::string& key, int& value) {
+  const auto n_opt = Get(key);
+  if (!n_opt) return;
+  const auto v = Convert<long long>(*n_opt, PathOf(key), "an integer");
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+    throw InvalidArgument(PathOf(key) + ": " + std::to_string(v) +
+                          " is out of range [-2147483648, 2147483647]");
+  }
+  value = static_cast<int>(v);
 }
 
 void YamlMap::Read(const std::string& key, std::uint32_t& value) {
@@ -114,30 +128,6 @@ void YamlMap::RejectUnknown() const {
     if (!used_.count(key)) unknown += (unknown.empty() ? "" : ", ") + PathOf(key);
   }
   if (!unknown.empty()) throw InvalidArgument("unknown key(s): " + unknown);
-}
-
-void RequireFinite(double value, const std::string& key) {
-  if (!std::isfinite(value))
-    throw InvalidArgument(key + ": value must be finite, got " + std::to_string(value));
-}
-
-void RequirePositive(double value, const std::string& key) {
-  RequireFinite(value, key);
-  if (!(value > 0.0)) throw InvalidArgument(key + ": must be > 0, got " + std::to_string(value));
-}
-
-void RequireNonNegative(double value, const std::string& key) {
-  RequireFinite(value, key);
-  if (value < 0.0) throw InvalidArgument(key + ": must be >= 0, got " + std::to_string(value));
-}
-
-void RequireInRange(double value, double lo, double hi, const std::string& key) {
-  RequireFinite(value, key);
-  if (value < lo || value > hi) {
-    std::ostringstream s;
-    s << key << ": " << value << " is out of range [" << lo << ", " << hi << "]";
-    throw InvalidArgument(s.str());
-  }
 }
 
 YAML::Node ParseYaml(const std::string& text, const std::string& what) {

@@ -23,6 +23,7 @@ class YamlMap {
   /// Each Read* leaves `value` untouched when the key is absent.
   void Read(const std::string& key, double& value);
   void Read(const std::string& key, bool& value);
+  void Read(const std::string& key, int& value);
   void Read(const std::string& key, std::uint32_t& value);
   void Read(const std::string& key, std::uint64_t& value);
   void Read(const std::string& key, std::string& value);
@@ -45,12 +46,6 @@ class YamlMap {
   std::string path_;
   std::set<std::string> used_;
 };
-
-/// Range checks with messages naming the key and the value.
-void RequireFinite(double value, const std::string& key);
-void RequirePositive(double value, const std::string& key);
-void RequireNonNegative(double value, const std::string& key);
-void RequireInRange(double value, double lo, double hi, const std::string& key);
 
 /// Parses YAML text; syntax errors become InvalidArgument with line and column.
 YAML::Node ParseYaml(const std::string& text, const std::string& what);

@@ -46,7 +46,7 @@
 #include <vector>
 
 #include "core/common/errors.h"
-#include "core/common/yaml_reader.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {

@@ -11,7 +11,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/common/errors.h"
-#include "core/common/yaml_reader.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {
@@ -20,8 +20,6 @@ namespace {
 constexpr double kMinSpread = 1e-6;
 // Below this |component| the next bin axis decides the sign (kAlongBinX).
 constexpr double kSignTol = 1e-6;
-// Largest ‖RᵀR − I‖ accepted for a rotation matrix.
-constexpr double kOrthonormalTol = 1e-6;
 // Rotation angles closer than this count as equal (PlanPlacement keeps the unflipped frame).
 constexpr double kAngleTieTol = 1e-9;
 
@@ -176,18 +174,6 @@ std::optional<TubeFrame> FrameOf(const Distribution& d, const std::string& what,
   frame.X_BinTube.linear().col(2) = z;
   frame.X_BinTube.translation() = params.origin == TubeFrameOrigin::kCentroid ? d.centroid : *p_Bin_grasp;
   return frame;
-}
-
-void RequireRigid(const Eigen::Isometry3d& X, const std::string& name) {
-  if (!X.matrix().allFinite()) throw InvalidArgument(name + ": pose must be finite");
-  const Eigen::Matrix3d R = X.linear();
-  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
-  if (error > kOrthonormalTol || R.determinant() < 0.0) {
-    std::ostringstream s;
-    s << name << ": rotation is not proper orthonormal (|R^T R - I| = " << error
-      << ", det = " << R.determinant() << ")";
-    throw InvalidArgument(s.str());
-  }
 }
 
 double RotationAngle(const Eigen::Isometry3d& X_A, const Eigen::Isometry3d& X_B) {

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "core/common/errors.h"
-#include "core/common/yaml_reader.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "core/common/errors.h"
-#include "core/common/yaml_reader.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {
@@ -20,10 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-void RequireFiniteVector(const Eigen::Vector3d& v, const std::string& key) {
-  for (int k = 0; k < 3; ++k) RequireFinite(v[k], key + "[" + std::to_string(k) + "]");
 }
 
 // max_z of Eq. 5.4.
@@ -93,8 +89,8 @@ void PlanningParams::Validate() const {
   RequirePositive(f.finger_length, "planning.filters.finger_length");
   RequireFinite(f.finger_tip_depth, "planning.filters.finger_tip_depth");
   RequirePositive(f.grid_cell_size, "planning.filters.grid_cell_size");
-  RequireFiniteVector(f.workspace_min, "planning.filters.workspace_min");
-  RequireFiniteVector(f.workspace_max, "planning.filters.workspace_max");
+  RequireFiniteComponents(f.workspace_min, "planning.filters.workspace_min");
+  RequireFiniteComponents(f.workspace_max, "planning.filters.workspace_max");
   for (int k = 0; k < 3; ++k) {
     if (f.workspace_min[k] > f.workspace_max[k]) {
       std::ostringstream s;

@@ -6,20 +6,9 @@
 #include <string>
 
 #include "core/common/errors.h"
-#include "core/common/yaml_reader.h"
+#include "core/common/require.h"
 
 namespace tubepick {
-namespace {
-
-void RequireFiniteVector(const Eigen::Vector3d& v, const std::string& key) {
-  if (!v.allFinite()) {
-    std::ostringstream s;
-    s << key << ": must be finite, got [" << v.x() << ", " << v.y() << ", " << v.z() << "]";
-    throw InvalidArgument(s.str());
-  }
-}
-
-}  // namespace
 
 std::string ToString(HeldOutcome outcome) {
   switch (outcome) {

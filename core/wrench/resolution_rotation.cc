@@ -3,17 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <string>
 #include <utility>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {
 
-// Largest ‖RᵀR − I‖ accepted for a rotation matrix.
-constexpr double kOrthonormalTol = 1e-6;
 // Yaws closer than this count as a tie (prefer +joint_safe_axis), radians.
 constexpr double kYawTieTol = 1e-9;
 
@@ -29,26 +27,6 @@ std::string FormatDegrees(double radians) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%+.1f deg", radians * 180.0 / M_PI);
   return buffer;
-}
-
-void RequireFiniteVector(const Eigen::Vector3d& v, const std::string& key) {
-  if (!v.allFinite()) {
-    std::ostringstream s;
-    s << key << ": must be finite, got [" << v.x() << ", " << v.y() << ", " << v.z() << "]";
-    throw InvalidArgument(s.str());
-  }
-}
-
-void RequireRigid(const Eigen::Isometry3d& X, const std::string& name) {
-  if (!X.matrix().allFinite()) throw InvalidArgument(name + ": pose must be finite");
-  const Eigen::Matrix3d R = X.linear();
-  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
-  if (error > kOrthonormalTol || R.determinant() < 0.0) {
-    std::ostringstream s;
-    s << name << ": rotation is not proper orthonormal (|R^T R - I| = " << error
-      << ", det = " << R.determinant() << ")";
-    throw InvalidArgument(s.str());
-  }
 }
 
 Eigen::Matrix3d Rotation(double angle, const Eigen::Vector3d& unit_axis) {
