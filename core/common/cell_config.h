@@ -62,4 +62,8 @@ struct CellConfig {
 CellConfig LoadCellConfig(const std::string& path);
 CellConfig ParseCellConfig(const std::string& yaml_text);
 
+/// YAML of every field of `cell`, with comments, that ParseCellConfig reads back to the same cell
+/// (poses go through a quaternion, so they return equal to ~1e-15).
+std::string DumpCellConfig(const CellConfig& cell);
+
 }  // namespace tubepick

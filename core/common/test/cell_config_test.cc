@@ -78,5 +78,26 @@ TEST(CellConfig, ReportsYamlSyntaxErrorWithLine) {
   }
 }
 
+TEST(CellConfig, DumpReadsBackToTheSameCell) {
+  CellConfig cell;
+  cell.bin.inner_size = Eigen::Vector3d(0.6, 0.4, 1.0 / 3.0);
+  cell.sensor.X_BinSensor.linear() =
+      Eigen::AngleAxisd(2.5, Eigen::Vector3d(1.0, 0.2, -0.3).normalized()).toRotationMatrix();
+  cell.sensor.unit = LengthUnit::kMillimetre;
+  cell.tube = {0.011, 0.0, 0.04};
+  cell.place.X_BinPlace.translation() = Eigen::Vector3d(0.1, -0.7, 0.05);
+  for (const CellConfig& expected : {CellConfig{}, cell}) {
+    const std::string yaml = DumpCellConfig(expected);
+    const CellConfig back = ParseCellConfig(yaml);
+    EXPECT_EQ(back.bin.inner_size, expected.bin.inner_size) << yaml;
+    EXPECT_TRUE(back.sensor.X_BinSensor.isApprox(expected.sensor.X_BinSensor, kTol)) << yaml;
+    EXPECT_EQ(back.sensor.unit, expected.sensor.unit);
+    EXPECT_EQ(back.tube.radius, expected.tube.radius);
+    EXPECT_EQ(back.tube.length, expected.tube.length);
+    EXPECT_EQ(back.tube.mass, expected.tube.mass);
+    EXPECT_TRUE(back.place.X_BinPlace.isApprox(expected.place.X_BinPlace, kTol)) << yaml;
+  }
+}
+
 }  // namespace
 }  // namespace tubepick

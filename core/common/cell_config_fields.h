@@ -1,0 +1,46 @@
+#pragma once
+
+// The YAML fields of the cell config (ParseCellConfig, DumpCellConfig and the server config's
+// `cell` section), declared once for the visitors of core/common/config_fields.h. Private to core
+// and the server.
+
+#include "core/common/cell_config.h"
+
+namespace tubepick {
+
+template <typename Visit>
+void DescribeFields(Visit& v, BinConfig& bin) {
+  v("inner_size", bin.inner_size, "Inner length (x), width (y) and wall height (z), m.");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, SensorConfig& sensor) {
+  v.Pose("pose_in_bin", sensor.X_BinSensor,
+         "X_BinSensor: the optical frame (x right, y down, z forward) in the bin frame.");
+  v.Enum(
+      "unit", sensor.unit, [](LengthUnit unit) { return ToString(unit); }, ParseLengthUnit,
+      "Unit of the sensor's clouds: m or mm.");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, TubeConfig& tube) {
+  v("radius", tube.radius, "Tube radius, m.");
+  v("length", tube.length, "Curve length, m; 0 = unknown.");
+  v("mass", tube.mass, "Mass of one tube, kg.");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, PlaceConfig& place) {
+  v.Pose("pose_in_bin", place.X_BinPlace,
+         "X_BinPlace: the frame a placed tube's PCA frame is aligned with, bin frame.");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, CellConfig& cell) {
+  v.Section("bin", cell.bin, "The bin: origin at the centre of its floor, z up, x along its length.");
+  v.Section("sensor", cell.sensor);
+  v.Section("tube", cell.tube);
+  v.Section("place", cell.place);
+}
+
+}  // namespace tubepick

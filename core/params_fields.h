@@ -1,0 +1,255 @@
+#pragma once
+
+// The YAML fields of every params section (ParseParams / DumpParams in core/params.cc), declared
+// once for the reader and the writer of core/common/config_fields.h. Private to core (and to the
+// cell controller's config, which shares the tool section).
+
+#include <string>
+
+#include "core/common/config_fields.h"
+#include "core/modeling/modeling_params.h"
+#include "core/params.h"
+#include "core/placement/placement.h"
+#include "core/planning/pick_planner.h"
+#include "core/wrench/wrench_params.h"
+
+namespace tubepick {
+namespace internal {
+
+// Text names of the modeling enums. Parse* @throws InvalidArgument naming `key`.
+const char* AxisName(Axis axis);
+Axis ParseAxis(const std::string& text, const std::string& key);
+const char* FrameName(FilterFrame frame);
+FilterFrame ParseFrame(const std::string& text, const std::string& key);
+const char* SurfaceName(SearchSurface surface);
+SearchSurface ParseSurface(const std::string& text, const std::string& key);
+const char* StrategyName(JoiningStrategy strategy);
+JoiningStrategy ParseStrategy(const std::string& text, const std::string& key);
+
+/// The filter pipeline as a YAML list: `- <FilterName>: {fields}`.
+const VariantListSpec<FilterStep>& FilterListSpec();
+
+}  // namespace internal
+
+// ---- modeling ---------------------------------------------------------------------------------
+
+template <typename Visit>
+void DescribeFields(Visit& v, CropBoxParams& p) {
+  v("from_bin", p.from_bin);
+  v("inset_xy", p.inset_xy);
+  v("min_z", p.min_z);
+  v("above_walls", p.above_walls);
+  v("min", p.min);
+  v("max", p.max);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, PassThroughParams& p) {
+  v.Enum("axis", p.axis, internal::AxisName, internal::ParseAxis);
+  v.Enum("frame", p.frame, internal::FrameName, internal::ParseFrame);
+  v("min", p.min);
+  v("max", p.max);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, VoxelGridParams& p) {
+  v("leaf_size", p.leaf_size);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, RandomSampleParams& p) {
+  v("count", p.count);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, RadiusOutlierParams& p) {
+  v("radius", p.radius);
+  v("min_neighbours", p.min_neighbours);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, StatisticalOutlierParams& p) {
+  v("neighbours", p.neighbours);
+  v("stddev_mult", p.stddev_mult);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, PlaneRemovalParams& p) {
+  v("distance_threshold", p.distance_threshold);
+  v("normal_distance_weight", p.normal_distance_weight);
+  v("axis", p.axis);
+  v("eps_angle", p.eps_angle, "radians");
+  v("max_iterations", p.max_iterations);
+  v("probability", p.probability);
+  v("min_inliers", p.min_inliers);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, NormalParams& p) {
+  v("radius", p.radius, "metres");
+  v("max_neighbours", p.max_neighbours, "0 = all within the radius");
+  v.Enum("search_surface", p.search_surface, internal::SurfaceName, internal::ParseSurface,
+         "raw or filtered");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, SegmentationParams& p) {
+  v("min_cluster_size", p.min_cluster_size);
+  v("max_cluster_size", p.max_cluster_size);
+  v("neighbours", p.neighbours);
+  v("smoothness_threshold", p.smoothness_threshold, "radians");
+  v("curvature_threshold", p.curvature_threshold);
+  v("residual_test", p.residual_test);
+  v("residual_threshold", p.residual_threshold);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, CylinderFitParams& p) {
+  v("min_inliers", p.min_inliers);
+  v("min_radius", p.min_radius, "metres");
+  v("max_radius", p.max_radius, "metres");
+  v("distance_threshold", p.distance_threshold);
+  v("normal_distance_weight", p.normal_distance_weight);
+  v("max_iterations", p.max_iterations);
+  v("probability", p.probability);
+  v("safety_length", p.safety_length, "epsilon_delta_l");
+  v("safety_radius", p.safety_radius, "epsilon_r");
+  v("refine", p.refine);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, JoiningParams& p) {
+  v("max_distance", p.max_distance);
+  v("max_angle", p.max_angle, "radians");
+  v("angular_weight", p.angular_weight, "metres per radian");
+  v("max_tube_length", p.max_tube_length);
+  v("radius_shortcut", p.radius_shortcut);
+  v("visibility_check", p.visibility_check);
+  v("visibility_pixel_angle", p.visibility_pixel_angle);
+  v("visibility_window", p.visibility_window);
+  v("visibility_min_gap", p.visibility_min_gap);
+  v.Enum("strategy", p.strategy, internal::StrategyName, internal::ParseStrategy, "greedy or global");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, ModelingParams& p) {
+  v("threads", p.threads, "0 = all cores");
+  v.VariantList("filters", p.filters, internal::FilterListSpec(), "applied in order, bin frame");
+  v.Section("normals", p.normals);
+  v.Section("segmentation", p.segmentation);
+  v.Section("cylinders", p.cylinders);
+  v.Section("joining", p.joining);
+}
+
+// ---- planning, wrench, placement --------------------------------------------------------------
+
+template <typename Visit>
+void DescribeFields(Visit& v, ClassificationParams& p) {
+  v("length_tolerance", p.length_tolerance);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, TrajectoryParams& p) {
+  v("upward_distance", p.upward_distance);
+  v("escape_first_lift", p.escape_first_lift);
+  v("escape_second_lift", p.escape_second_lift);
+  v("escape_constant", p.escape_constant);
+  v("safety_margin", p.safety_margin);
+  v("min_escape_distance", p.min_escape_distance);
+  v("occlusion_escapes", p.occlusion_escapes);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, GraspParams& p) {
+  v("spacing", p.spacing);
+  v("min_base_distance", p.min_base_distance);
+  v("opening_width", p.opening_width);
+  v("max_axis_inclination", p.max_axis_inclination);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, GraspFilterParams& p) {
+  v("finger_thickness", p.finger_thickness);
+  v("finger_width", p.finger_width);
+  v("finger_length", p.finger_length);
+  v("finger_tip_depth", p.finger_tip_depth);
+  v("max_points_in_fingers", p.max_points_in_fingers);
+  v("grid_cell_size", p.grid_cell_size);
+  v("workspace_min", p.workspace_min);
+  v("workspace_max", p.workspace_max);
+}
+
+/// The tool boxes of ToolParams without `check`: also the cell controller's `tool` section.
+template <typename Visit>
+void DescribeToolGeometryFields(Visit& v, ToolParams& p) {
+  v("finger_size", p.finger_size, "one pad: along the tube, closing, height, m");
+  v("finger_tip_depth", p.finger_tip_depth, "tips past the TCP along z_Tcp, m");
+  v("housing_size", p.housing_size, "m");
+  v("housing_gap", p.housing_gap, "housing bottom above the pads' top, m");
+  v("margin", p.margin, "kept from the bin's walls and floor, m");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, ToolParams& p) {
+  v("check", p.check);
+  DescribeToolGeometryFields(v, p);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, CostParams& p) {
+  v("height_weight", p.height_weight);
+  v("centre_weight", p.centre_weight);
+  v("trajectory_weight", p.trajectory_weight);
+  v("max_displacement", p.max_displacement);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, PlanningParams& p) {
+  v.Section("classification", p.classification);
+  v.Section("trajectories", p.trajectories);
+  v.Section("grasps", p.grasps);
+  v.Section("filters", p.filters);
+  v.Section("tool", p.tool);
+  v.Section("cost", p.cost);
+  v("empty_max_points", p.empty_max_points);
+  v("empty_min_height", p.empty_min_height);
+  v("strongly_occluded_candidates", p.strongly_occluded_candidates);
+  v("max_plans", p.max_plans);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, WrenchParams& p) {
+  v("gravity", p.gravity);
+  v("force_tolerance", p.force_tolerance);
+  v("max_tilt", p.max_tilt);
+  v("rotation_angle", p.rotation_angle);
+  v("min_torque", p.min_torque);
+  v.Enum(
+      "variant", p.variant, [](ResolutionVariant x) { return ToString(x); }, ParseResolutionVariant);
+  v("joint_safe_axis", p.joint_safe_axis);
+  v.Enum(
+      "joint_safe_frame", p.joint_safe_frame, [](JointSafeFrame x) { return ToString(x); },
+      ParseJointSafeFrame);
+  v("joint_safe_min_yaw", p.joint_safe_min_yaw);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, PlacementParams& p) {
+  v("yaw_only", p.yaw_only);
+  v.Enum(
+      "origin", p.origin, [](TubeFrameOrigin x) { return ToString(x); }, ParseTubeFrameOrigin);
+  v.Enum(
+      "sign", p.sign, [](AxisSign x) { return ToString(x); }, ParseAxisSign);
+  v("min_horizontal", p.min_horizontal);
+  v("allow_flip", p.allow_flip);
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, Params& p) {
+  v.Section("modeling", p.modeling);
+  v.Section("planning", p.planning);
+  v.Section("wrench", p.wrench);
+  v.Section("placement", p.placement);
+}
+
+}  // namespace tubepick
