@@ -5,132 +5,32 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
-
+#include "core/common/cell_config_fields.h"
+#include "core/common/config_fields.h"
 #include "core/common/errors.h"
 #include "core/common/require.h"
-#include "core/common/yaml_reader.h"
 
 namespace tubepick::server {
+
+// The `server.tls` section (in the namespace of TlsConfig, where the config visitors look for it).
+template <typename Visit>
+void DescribeFields(Visit& v, TlsConfig& tls) {
+  v("cert_file", tls.cert_file,
+    "PEM certificate chain and private key of the server; both empty = plaintext.");
+  v("key_file", tls.key_file);
+  v("client_ca_file", tls.client_ca_file,
+    "PEM CA bundle client certificates are verified against (mutual TLS); \"\" = none requested.");
+  v("require_client_cert", tls.require_client_cert,
+    "Reject clients without a valid certificate (needs client_ca_file).");
+}
+
 namespace {
 
 constexpr std::uint64_t kMiB = 1ull << 20;
 constexpr std::uint64_t kGiB = 1ull << 30;
-
-// The defaults of every key, documented. Keep in sync with the structs: server_config_test parses
-// it and compares every field with a default-constructed ServerConfig.
-constexpr std::string_view kEmbeddedYaml =
-    R"yaml(# tubepick-server configuration: every key with its default (tubepick-server --config FILE).
-# Every key is optional; unknown keys are errors. Units: metres, kilograms, seconds.
-# Relative file paths are relative to the directory of this file.
-
-server:
-  # gRPC listen address, HOST:PORT; port 0 = any free port; IPv6 as "[::]:50051".
-  address: "0.0.0.0:50051"
-  # Planning worker threads; 0 = one per hardware thread.
-  workers: 0
-  # Admitted calls that may wait for a free worker; more are answered RESOURCE_EXHAUSTED. >= 1.
-  queue_capacity: 8
-  # Largest gRPC message received or sent, bytes, in [1 MiB, 2 GiB): 64 MiB.
-  max_message_bytes: 67108864
-  # Largest cloud a PlanPickStream header may announce, bytes: 512 MiB.
-  max_stream_bytes: 536870912
-  # On SIGTERM, in-flight calls get this long to finish before they are cancelled, seconds.
-  shutdown_grace: 10.0
-  # Prometheus text metrics at http://HOST:PORT/metrics; "" = off.
-  metrics_address: "0.0.0.0:9464"
-  # trace, debug, info, warn, error, critical or off.
-  log_level: info
-  # text, or json (one JSON object per line).
-  log_format: text
-  tls:
-    # PEM certificate chain and private key of the server; both empty = plaintext.
-    cert_file: ""
-    key_file: ""
-    # PEM CA bundle client certificates are verified against (mutual TLS); "" = none requested.
-    client_ca_file: ""
-    # Reject clients without a valid certificate (needs client_ca_file).
-    require_client_cert: false
-
-planning:
-  # Parameter profile of requests that name none: fast or thesis.
-  profile: fast
-  # Seed of requests that give none.
-  seed: 1
-  # A `tubepick params --dump` YAML (complete or partial) that replaces the parameters of the
-  # profile above; "" = the compiled-in profile.
-  params_file: ""
-  # Largest cloud accepted, points (12 bytes each).
-  max_cloud_points: 10000000
-  # Threads one PlanPick simulates its trajectories on; 0 = one per hardware thread. Calls already
-  # run in parallel on the workers, so 1 keeps workers x threads at the core count.
-  simulation_threads: 1
-  # Trajectory simulation (Bullet). The bin and the tube mass come from the request's cell, the
-  # displacement limit from the profile's planning.cost.max_displacement.
-  simulation:
-    # Speed of the grasped tube along its waypoints, m/s.
-    gripper_speed: 0.1
-    # Fixed simulation step, s (1/120).
-    time_step: 0.008333333333333333
-    # Sequential-impulse solver iterations per step.
-    solver_iterations: 10
-    # Longest settling under gravity before the snapshot, s.
-    settle_time: 2.0
-    # Settling ends once every tube has stayed below the rest velocities this long, s.
-    rest_time: 0.1
-    # Rest velocities, m/s and rad/s.
-    linear_rest_velocity: 0.01
-    angular_rest_velocity: 0.1
-    # The grasped tube is held still at its last waypoint this long before measuring, s.
-    post_motion_time: 0.5
-    # Friction coefficients of tubes and bin; rolling friction of tubes, m.
-    tube_friction: 0.7
-    bin_friction: 0.7
-    tube_rolling_friction: 0.001
-    # Restitution of tubes and bin.
-    tube_restitution: 0.2
-    bin_restitution: 0.5
-    # Velocity damping of tubes, fraction lost per second.
-    linear_damping: 0.05
-    angular_damping: 0.2
-    # Collision margin of flat tube ends and bin walls, m.
-    collision_margin: 0.001
-    # Consecutive cylinders farther apart than this are linked by a joint cylinder, m.
-    joint_min_length: 0.001
-    # Sleep thresholds of a tube woken during a trajectory, m/s and rad/s; 0 disables sleeping.
-    sleep_linear_velocity: 0.02
-    sleep_angular_velocity: 0.2
-    # Simulated bin wall thickness, m.
-    wall_thickness: 0.05
-
-# The cell of requests that carry no CellDescription (the schema of `tubepick --cell FILE`).
-# Alternatively cell_file names such a file; give one of the two.
-cell_file: ""
-cell:
-  bin:
-    # Inner length (x), width (y) and wall height (z), m.
-    inner_size: [0.8, 0.6, 0.2]
-  sensor:
-    # X_BinSensor: the optical frame (x right, y down, z forward) in the bin frame;
-    # 1.1 m above the floor centre looking straight down.
-    pose_in_bin:
-      position: [0.0, 0.0, 1.1]
-      orientation_xyzw: [1.0, 0.0, 0.0, 0.0]
-    # Unit of the sensor's clouds (requests with LENGTH_UNIT_UNSPECIFIED): m or mm.
-    unit: m
-  tube:
-    # Radius, curve length (0 = unknown) and mass of one tube, m and kg.
-    radius: 0.0125
-    length: 0.5
-    mass: 0.055
-  place:
-    # X_BinPlace: the frame a placed tube's PCA frame is aligned with, bin frame.
-    pose_in_bin:
-      position: [0.0, 0.8, 0.1]
-      orientation_xyzw: [0.0, 0.0, 0.0, 1.0]
-)yaml";
 
 std::string ResolvePath(const std::string& path, const std::string& base_dir) {
   if (path.empty()) return path;
@@ -165,84 +65,157 @@ std::string PrefixCellError(const std::string& message) {
   return "cell." + message;
 }
 
-void ReadSimulation(YamlMap& m, physics::TrajectorySimParams& s) {
-  m.Read("gripper_speed", s.gripper_speed);
-  m.Read("time_step", s.time_step);
-  std::uint32_t iterations = static_cast<std::uint32_t>(s.solver_iterations);
-  m.Read("solver_iterations", iterations);
-  if (iterations > 1000) {
-    throw InvalidArgument(m.PathOf("solver_iterations") + ": " + std::to_string(iterations) +
-                          " is out of range [1, 1000]");
-  }
-  s.solver_iterations = static_cast<int>(iterations);
-  m.Read("settle_time", s.settle_time);
-  m.Read("rest_time", s.rest_time);
-  m.Read("linear_rest_velocity", s.linear_rest_velocity);
-  m.Read("angular_rest_velocity", s.angular_rest_velocity);
-  m.Read("post_motion_time", s.post_motion_time);
-  m.Read("tube_friction", s.tube_friction);
-  m.Read("bin_friction", s.bin_friction);
-  m.Read("tube_rolling_friction", s.tube_rolling_friction);
-  m.Read("tube_restitution", s.tube_restitution);
-  m.Read("bin_restitution", s.bin_restitution);
-  m.Read("linear_damping", s.linear_damping);
-  m.Read("angular_damping", s.angular_damping);
-  m.Read("collision_margin", s.collision_margin);
-  m.Read("joint_min_length", s.joint_min_length);
-  m.Read("sleep_linear_velocity", s.sleep_linear_velocity);
-  m.Read("sleep_angular_velocity", s.sleep_angular_velocity);
-  m.Read("wall_thickness", s.wall_thickness);
-  m.RejectUnknown();
+// ---- the server YAML: field declarations (core/common/config_fields.h) ---------------------------
+
+constexpr std::string_view kHeader =
+    "tubepick-server configuration: every key with its default (tubepick-server --config FILE).\n"
+    "Every key is optional; unknown keys are errors. Units: metres, kilograms, seconds.\n"
+    "Relative file paths are relative to the directory of this file.";
+
+/// The server YAML document: the ServerConfig fields plus the keys that name files to load.
+struct ServerFile {
+  ServerConfig config;
+  /// planning.params_file: a params YAML over the default profile; "" = none.
+  std::string params_file;
+  /// A cell YAML, or the `cell` section (nullopt: absent or null); at most one of the two.
+  std::string cell_file;
+  std::optional<CellConfig> cell;
+};
+
+/// The `server` section: ServerConfig without its planning defaults.
+struct ServerSection {
+  ServerConfig& config;
+};
+
+/// The `planning` section: PlanningDefaults and params_file.
+struct PlanningSection {
+  PlanningDefaults& defaults;
+  std::string& params_file;
+};
+
+/// The `planning.simulation` section: the TrajectorySimParams an operator sets (the bin, tube mass,
+/// disp_max and threads are filled per request).
+struct SimulationSection {
+  physics::TrajectorySimParams& s;
+};
+
+template <typename Visit>
+void DescribeFields(Visit& v, ServerSection& section) {
+  ServerConfig& c = section.config;
+  v("address", c.address, "gRPC listen address, HOST:PORT; port 0 = any free port; IPv6 as \"[::]:50051\".");
+  v("workers", c.workers, "Planning worker threads; 0 = one per hardware thread.");
+  v("queue_capacity", c.queue_capacity,
+    "Admitted calls that may wait for a free worker; more are answered RESOURCE_EXHAUSTED. >= 1.");
+  v("max_message_bytes", c.max_message_bytes,
+    "Largest gRPC message received or sent, bytes, in [1 MiB, 2 GiB): 64 MiB.");
+  v("max_stream_bytes", c.max_stream_bytes,
+    "Largest cloud a PlanPickStream header may announce, bytes: 512 MiB.");
+  v("shutdown_grace", c.shutdown_grace,
+    "On SIGTERM, in-flight calls get this long to finish before they are cancelled, seconds.");
+  v("metrics_address", c.metrics_address, "Prometheus text metrics at http://HOST:PORT/metrics; \"\" = off.");
+  v("log_level", c.log_level, "trace, debug, info, warn, error, critical or off.");
+  v("log_format", c.log_format, "text, or json (one JSON object per line).");
+  v.Section("tls", c.tls);
 }
 
-void ReadServer(YamlMap& m, ServerConfig& c, const std::string& base_dir) {
-  m.Read("address", c.address);
-  m.Read("workers", c.workers);
-  m.Read("queue_capacity", c.queue_capacity);
-  m.Read("max_message_bytes", c.max_message_bytes);
-  m.Read("max_stream_bytes", c.max_stream_bytes);
-  m.Read("shutdown_grace", c.shutdown_grace);
-  m.Read("metrics_address", c.metrics_address);
-  m.Read("log_level", c.log_level);
-  m.Read("log_format", c.log_format);
-  {
-    YamlMap tls(m.Child("tls"), m.PathOf("tls"));
-    tls.Read("cert_file", c.tls.cert_file);
-    tls.Read("key_file", c.tls.key_file);
-    tls.Read("client_ca_file", c.tls.client_ca_file);
-    tls.Read("require_client_cert", c.tls.require_client_cert);
-    tls.RejectUnknown();
-    c.tls.cert_file = ResolvePath(c.tls.cert_file, base_dir);
-    c.tls.key_file = ResolvePath(c.tls.key_file, base_dir);
-    c.tls.client_ca_file = ResolvePath(c.tls.client_ca_file, base_dir);
-  }
-  m.RejectUnknown();
+template <typename Visit>
+void DescribeFields(Visit& v, SimulationSection& section) {
+  physics::TrajectorySimParams& s = section.s;
+  v("gripper_speed", s.gripper_speed, "Speed of the grasped tube along its waypoints, m/s.");
+  v("time_step", s.time_step, "Fixed simulation step, s (1/120).");
+  v("solver_iterations", s.solver_iterations, "Sequential-impulse solver iterations per step.");
+  v("settle_time", s.settle_time, "Longest settling under gravity before the snapshot, s.");
+  v("rest_time", s.rest_time,
+    "Settling ends once every tube has stayed below the rest velocities this long, s.");
+  v("linear_rest_velocity", s.linear_rest_velocity, "Rest velocities, m/s and rad/s.");
+  v("angular_rest_velocity", s.angular_rest_velocity);
+  v("post_motion_time", s.post_motion_time,
+    "The grasped tube is held still at its last waypoint this long before measuring, s.");
+  v("tube_friction", s.tube_friction,
+    "Friction coefficients of tubes and bin; rolling friction of tubes, m.");
+  v("bin_friction", s.bin_friction);
+  v("tube_rolling_friction", s.tube_rolling_friction);
+  v("tube_restitution", s.tube_restitution, "Restitution of tubes and bin.");
+  v("bin_restitution", s.bin_restitution);
+  v("linear_damping", s.linear_damping, "Velocity damping of tubes, fraction lost per second.");
+  v("angular_damping", s.angular_damping);
+  v("collision_margin", s.collision_margin, "Collision margin of flat tube ends and bin walls, m.");
+  v("joint_min_length", s.joint_min_length,
+    "Consecutive cylinders farther apart than this are linked by a joint cylinder, m.");
+  v("sleep_linear_velocity", s.sleep_linear_velocity,
+    "Sleep thresholds of a tube woken during a trajectory, m/s and rad/s; 0 disables sleeping.");
+  v("sleep_angular_velocity", s.sleep_angular_velocity);
+  v("wall_thickness", s.wall_thickness, "Simulated bin wall thickness, m.");
 }
 
-void ReadPlanning(YamlMap& m, PlanningDefaults& p, const std::string& base_dir) {
-  m.Read("profile", p.profile);
+template <typename Visit>
+void DescribeFields(Visit& v, PlanningSection& section) {
+  PlanningDefaults& p = section.defaults;
+  v("profile", p.profile, "Parameter profile of requests that name none: fast or thesis.");
+  v("seed", p.seed, "Seed of requests that give none.");
+  v("params_file", section.params_file,
+    "A `tubepick params --dump` YAML (complete or partial) that replaces the parameters of the\n"
+    "profile above; \"\" = the compiled-in profile.");
+  v("max_cloud_points", p.max_cloud_points, "Largest cloud accepted, points (12 bytes each).");
+  v("simulation_threads", p.simulation_threads,
+    "Threads one PlanPick simulates its trajectories on; 0 = one per hardware thread. Calls already\n"
+    "run in parallel on the workers, so 1 keeps workers x threads at the core count.");
+  SimulationSection simulation{p.simulation};
+  v.Section("simulation", simulation,
+            "Trajectory simulation (Bullet). The bin and the tube mass come from the request's cell, the\n"
+            "displacement limit from the profile's planning.cost.max_displacement.");
+}
+
+template <typename Visit>
+void DescribeFields(Visit& v, ServerFile& file) {
+  ServerSection server{file.config};
+  v.Section("server", server);
+  PlanningSection planning{file.config.planning, file.params_file};
+  v.Section("planning", planning);
+  v.Heading(
+      "The cell of requests that carry no CellDescription (the schema of `tubepick --cell FILE`).\n"
+      "Alternatively cell_file names such a file; give one of the two.");
+  v("cell_file", file.cell_file);
+  v.OptionalSection("cell", file.cell);
+}
+
+// ---- the server YAML: behaviour after reading ---------------------------------------------------
+
+void ResolveTlsPaths(TlsConfig& tls, const std::string& base_dir) {
+  tls.cert_file = ResolvePath(tls.cert_file, base_dir);
+  tls.key_file = ResolvePath(tls.key_file, base_dir);
+  tls.client_ca_file = ResolvePath(tls.client_ca_file, base_dir);
+}
+
+// Replaces the default profile's params with `params_file` read over them.
+void ApplyParamsFile(const std::string& params_file, const std::string& base_dir, PlanningDefaults& p) {
   if (!p.profiles.count(p.profile)) {
-    throw InvalidArgument(m.PathOf("profile") + ": unknown profile '" + p.profile +
+    throw InvalidArgument("planning.profile: unknown profile '" + p.profile +
                           "' (known: " + JoinNames(p.profiles) + ")");
   }
-  m.Read("seed", p.seed);
-  std::string params_file;
-  m.Read("params_file", params_file);
-  if (!params_file.empty()) {
-    const std::string path = ResolvePath(params_file, base_dir);
+  if (params_file.empty()) return;
+  const std::string path = ResolvePath(params_file, base_dir);
+  try {
+    p.profiles[p.profile] = LoadParams(path, p.profiles.at(p.profile));
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("planning.params_file: " + std::string(e.what()));
+  }
+}
+
+// The cell of the `cell` section or of `cell_file` (relative to base_dir); the default without either.
+void ApplyCell(const ServerFile& file, const std::string& base_dir, CellConfig& cell) {
+  if (file.cell && !file.cell_file.empty()) {
+    throw InvalidArgument("cell_file: '" + file.cell_file + "' and a cell section: give one of the two");
+  }
+  if (file.cell) {
+    cell = *file.cell;  // validated with the config (PrefixCellError)
+  } else if (!file.cell_file.empty()) {
     try {
-      p.profiles[p.profile] = LoadParams(path, p.profiles.at(p.profile));
+      cell = LoadCellConfig(ResolvePath(file.cell_file, base_dir));
     } catch (const InvalidArgument& e) {
-      throw InvalidArgument(m.PathOf("params_file") + ": " + e.what());
+      throw InvalidArgument(std::string("cell_file: ") + e.what());
     }
   }
-  m.Read("max_cloud_points", p.max_cloud_points);
-  m.Read("simulation_threads", p.simulation_threads);
-  {
-    YamlMap sim(m.Child("simulation"), m.PathOf("simulation"));
-    ReadSimulation(sim, p.simulation);
-  }
-  m.RejectUnknown();
 }
 
 bool ValidHost(const std::string& host) {
@@ -370,42 +343,22 @@ void ServerConfig::Validate() const {
   }
 }
 
-std::string_view EmbeddedServerConfigYaml() { return kEmbeddedYaml; }
+std::string_view EmbeddedServerConfigYaml() {
+  static const std::string yaml = [] {
+    ServerFile defaults;
+    defaults.cell = CellConfig{};
+    return DumpFields(defaults, kHeader);
+  }();
+  return yaml;
+}
 
 ServerConfig ParseServerConfig(const std::string& yaml_text, const std::string& base_dir) {
-  const YAML::Node root = ParseYaml(yaml_text, "server config");
-  YamlMap top(root, "");
-  ServerConfig config;
-  {
-    YamlMap server(top.Child("server"), "server");
-    ReadServer(server, config, base_dir);
-  }
-  {
-    YamlMap planning(top.Child("planning"), "planning");
-    ReadPlanning(planning, config.planning, base_dir);
-  }
-  std::string cell_file;
-  top.Read("cell_file", cell_file);
-  const bool has_cell = top.Has("cell") && !top.Child("cell").IsNull();
-  if (has_cell && !cell_file.empty()) {
-    throw InvalidArgument("cell_file: '" + cell_file + "' and a cell section: give one of the two");
-  }
-  if (has_cell) {
-    const YAML::Node cell = top.Child("cell");
-    if (!cell.IsMap()) throw InvalidArgument("cell: expected a mapping");
-    try {
-      config.planning.cell = ParseCellConfig(YAML::Dump(cell));
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(PrefixCellError(e.what()));
-    }
-  } else if (!cell_file.empty()) {
-    try {
-      config.planning.cell = LoadCellConfig(ResolvePath(cell_file, base_dir));
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(std::string("cell_file: ") + e.what());
-    }
-  }
-  top.RejectUnknown();
+  ServerFile file;
+  ParseFields(yaml_text, "server config", file);
+  ServerConfig config = std::move(file.config);
+  ResolveTlsPaths(config.tls, base_dir);
+  ApplyParamsFile(file.params_file, base_dir, config.planning);
+  ApplyCell(file, base_dir, config.planning.cell);
   config.Validate();
   return config;
 }

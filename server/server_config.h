@@ -80,7 +80,8 @@ struct ServerConfig {
 /// @throws InvalidArgument naming `key` and the address.
 void ValidateHostPort(const std::string& address, const std::string& key);
 
-/// The built-in default configuration as YAML (every key, with comments).
+/// The built-in default configuration as YAML (every key, with comments): the dump of a
+/// default-constructed ServerConfig, written from the same field declarations the parser reads.
 std::string_view EmbeddedServerConfigYaml();
 
 /// Parses a server YAML strictly on top of the defaults. Sections: `server` (address, workers, ...,
