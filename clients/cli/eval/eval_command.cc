@@ -197,13 +197,8 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
   out.tube_count = static_cast<std::uint32_t>(tubes_Bin.size());
   out.input_points = points_Sensor.size();
 
-  ModelingInput input;
-  input.points_Sensor = &points_Sensor;
-  input.unit = unit;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.seed = o.common.seed;
-  const ModelingResult result = ModelTubes(input, params.modeling);
+  const ModelingResult result =
+      ModelTubes(MakeModelingInput(points_Sensor, unit, cell, o.common.seed), params.modeling);
   out.evaluation = EvaluateScene(result, labels, out.tube_count, eval_params);
   out.snapshot = MakeSnapshot(result, labels, tubes_Bin, eval_params, cell.bin);
   return out;

@@ -54,10 +54,11 @@ CloudInput LoadCloudInput(const InputOptions& o, const CellConfig& cell) {
   return input;
 }
 
-ModelingInput MakeModelingInput(const CloudInput& cloud, const CellConfig& cell, std::uint64_t seed) {
+ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, const CellConfig& cell,
+                                std::uint64_t seed) {
   ModelingInput input;
-  input.points_Sensor = &cloud.points_Sensor;
-  input.unit = cloud.unit;
+  input.points_Sensor = &points_Sensor;
+  input.unit = unit;
   input.X_BinSensor = cell.sensor.X_BinSensor;
   input.bin = cell.bin;
   input.seed = seed;

@@ -42,8 +42,10 @@ struct CloudInput {
 /// Reads --cloud (in --unit or the cell's unit) or makes the built-in scene.
 CloudInput LoadCloudInput(const InputOptions& options, const CellConfig& cell);
 
-/// The modeling input for `cloud` in `cell` (it points into `cloud`, which must outlive it).
-ModelingInput MakeModelingInput(const CloudInput& cloud, const CellConfig& cell, std::uint64_t seed);
+/// The modeling input for a cloud in the sensor frame, in `unit`, seen in `cell` (it points into
+/// `points_Sensor`, which must outlive it).
+ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, const CellConfig& cell,
+                                std::uint64_t seed);
 
 /// The cell from --cell, or the embedded default (ARCHITECTURE.md's example).
 CellConfig LoadCell(const CommonOptions& options);

@@ -43,23 +43,4 @@ std::vector<std::string> FindSceneDirectories(const std::string& root) {
   return found;
 }
 
-std::string FormatCellYaml(const CellConfig& cell) {
-  auto pose = [](const Eigen::Isometry3d& X) {
-    const Eigen::Vector3d p = X.translation();
-    const Eigen::Quaterniond q(X.rotation());
-    return fmt::format(
-        "    position: [{:.9g}, {:.9g}, {:.9g}]\n    orientation_xyzw: [{:.9g}, {:.9g}, {:.9g}, {:.9g}]\n",
-        p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
-  };
-  const Eigen::Vector3d& size = cell.bin.inner_size;
-  std::string text = "# Cell written by tubepick scene (see ARCHITECTURE.md). SI units.\n";
-  text += fmt::format("bin:\n  inner_size: [{:.9g}, {:.9g}, {:.9g}]\n", size.x(), size.y(), size.z());
-  text += "sensor:\n  pose_in_bin:\n" + pose(cell.sensor.X_BinSensor);
-  text += fmt::format("  unit: {}\n", ToString(cell.sensor.unit));
-  text += fmt::format("tube:\n  radius: {:.9g}\n  length: {:.9g}\n  mass: {:.9g}\n", cell.tube.radius,
-                      cell.tube.length, cell.tube.mass);
-  text += "place:\n  pose_in_bin:\n" + pose(cell.place.X_BinPlace);
-  return text;
-}
-
 }  // namespace tubepick::cli

@@ -16,7 +16,7 @@ namespace tubepick::cli {
 ///   labels.txt  one ground-truth label per cloud point (tube index ≥ 0 into tubes.txt, −1 bin or
 ///               ground, −2 outlier)
 ///   tubes.txt   the settled tubes, Bin frame, in the published `tube_configurations` format
-///   cell.yaml   the cell used (bin, sensor pose and unit, tube)
+///   cell.yaml   the cell used (bin, sensor pose and unit, tube; DumpCellConfig)
 ///   scene.json  how it was made (tubes, preset, seed, settling) — informative only
 inline constexpr const char* kSceneCloudFile = "cloud.ply";
 inline constexpr const char* kSceneLabelsFile = "labels.txt";
@@ -39,8 +39,5 @@ SceneData ReadSceneDirectory(const std::string& directory, const CellConfig& fal
 /// Every directory at or below `root` holding cloud.ply, labels.txt and tubes.txt, sorted.
 /// @throws InvalidArgument when `root` is not a directory.
 std::vector<std::string> FindSceneDirectories(const std::string& root);
-
-/// A cell YAML (ARCHITECTURE.md layout) that LoadCellConfig reads back to `cell`.
-std::string FormatCellYaml(const CellConfig& cell);
 
 }  // namespace tubepick::cli

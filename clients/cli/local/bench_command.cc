@@ -67,12 +67,7 @@ void RunBench(const BenchOptions& o) {
   fmt::print("bench modeling: {} ({} points), {} repetitions after 1 warm-up, {} hardware threads\n", source,
              points_Sensor.size(), o.repetitions, std::thread::hardware_concurrency());
 
-  ModelingInput input;
-  input.points_Sensor = &points_Sensor;
-  input.unit = unit;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.seed = o.common.seed;
+  const ModelingInput input = MakeModelingInput(points_Sensor, unit, cell, o.common.seed);
 
   std::vector<ProfileFigures> figures;
   for (const std::string& profile : o.profiles) {
@@ -152,11 +147,8 @@ void RunPlanBench(const PlanBenchOptions& o) {
   const CellConfig cell = LoadCell(o.common);
   const Params params = LoadParamsFor(o.common);
   BuiltInScene scene = MakeBuiltInScene(cell, o.tubes, o.common.seed);
-  ModelingInput input;
-  input.points_Sensor = &scene.points_Sensor;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.seed = o.common.seed;
+  const ModelingInput input =
+      MakeModelingInput(scene.points_Sensor, LengthUnit::kMetre, cell, o.common.seed);  // scanner: metres
   fmt::print("bench plan: {} ({} points), profile {}, {} repetitions after 1 warm-up\n", scene.description,
              scene.points_Sensor.size(), o.common.profile, o.repetitions);
 

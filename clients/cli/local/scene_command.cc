@@ -38,7 +38,7 @@ void Run(const SceneOptions& o) {
   std::filesystem::create_directories(dir);
   physics::WriteScan((dir / kSceneCloudFile).string(), (dir / kSceneLabelsFile).string(), scene.scan);
   physics::WriteTubeConfigurations((dir / kSceneTubesFile).string(), scene.drop.tubes);
-  WriteTextFile((dir / kSceneCellFile).string(), FormatCellYaml(cell));
+  WriteTextFile((dir / kSceneCellFile).string(), DumpCellConfig(cell));
 
   std::uint32_t outside = 0;
   for (bool inside : scene.drop.inside_bin) outside += inside ? 0 : 1;

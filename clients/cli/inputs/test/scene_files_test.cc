@@ -9,6 +9,8 @@
 
 #include "core/common/errors.h"
 #include "core/modeling/cloud_io.h"
+#include "physics/scan_io.h"
+#include "physics/tube_config_io.h"
 
 namespace tubepick::cli {
 namespace {
@@ -25,21 +27,38 @@ fs::path FreshDir(const std::string& name) {
   return dir;
 }
 
-TEST(SceneFiles, CellYamlReadsBackToTheSameCell) {
+/// A scene directory of three points labelled tube 0, background, outlier, and no tubes.
+fs::path WriteScene(const std::string& name) {
+  const fs::path dir = FreshDir(name);
+  WritePly((dir / kSceneCloudFile).string(), Points(3, Eigen::Vector3f(0.f, 0.f, 1.f)));
+  physics::WriteLabels((dir / kSceneLabelsFile).string(), {0, -1, -2});
+  physics::WriteTubeConfigurations((dir / kSceneTubesFile).string(), {});
+  return dir;
+}
+
+TEST(SceneFiles, TheCellWrittenBesideTheSceneIsTheOneReadBack) {
   CellConfig cell;
   cell.bin.inner_size = {0.7, 0.5, 0.25};
   cell.sensor.unit = LengthUnit::kMillimetre;
   cell.sensor.X_BinSensor.translation() = Eigen::Vector3d(0.01, -0.02, 1.3);
   cell.tube = {.radius = 0.01, .length = 0.4, .mass = 0.07};
-  cell.place.X_BinPlace = Eigen::Isometry3d(Eigen::Translation3d(0.1, 0.9, 0.05));
-  const fs::path file = FreshDir("tubepick_scene_files_cell") / "cell.yaml";
-  std::ofstream(file) << FormatCellYaml(cell);
-  const CellConfig back = LoadCellConfig(file.string());
-  EXPECT_TRUE(back.bin.inner_size.isApprox(cell.bin.inner_size, kTol));
-  EXPECT_EQ(back.sensor.unit, LengthUnit::kMillimetre);
-  EXPECT_TRUE(back.sensor.X_BinSensor.isApprox(cell.sensor.X_BinSensor, kTol));
-  EXPECT_NEAR(back.tube.mass, 0.07, kTol);
-  EXPECT_TRUE(back.place.X_BinPlace.isApprox(cell.place.X_BinPlace, kTol));
+  const fs::path dir = WriteScene("tubepick_scene_files_cell");
+  std::ofstream(dir / kSceneCellFile) << DumpCellConfig(cell);  // what `tubepick scene` writes
+  const SceneData scene = ReadSceneDirectory(dir.string(), CellConfig{});
+  EXPECT_EQ(scene.points_Sensor.size(), 3u);
+  EXPECT_EQ(scene.labels, (std::vector<std::int32_t>{0, -1, -2}));
+  EXPECT_TRUE(scene.tubes_Bin.empty());
+  EXPECT_TRUE(scene.cell.bin.inner_size.isApprox(cell.bin.inner_size, kTol));
+  EXPECT_EQ(scene.cell.sensor.unit, LengthUnit::kMillimetre);
+  EXPECT_TRUE(scene.cell.sensor.X_BinSensor.isApprox(cell.sensor.X_BinSensor, kTol));
+  EXPECT_NEAR(scene.cell.tube.mass, 0.07, kTol);
+}
+
+TEST(SceneFiles, WithoutACellFileTheFallbackCellApplies) {
+  CellConfig fallback;
+  fallback.tube.radius = 0.02;
+  const SceneData scene = ReadSceneDirectory(WriteScene("tubepick_scene_files_fallback").string(), fallback);
+  EXPECT_EQ(scene.cell.tube.radius, 0.02);
 }
 
 TEST(SceneFiles, FindsOnlyCompleteSceneDirectoriesSorted) {
