@@ -11,13 +11,14 @@
 #include <vector>
 
 #include "core/common/errors.h"
-#include "server/test/error_of.h"
+#include "core/testing/error_of.h"
 
 namespace tubepick::server {
 namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using tubepick::testing::ErrorOf;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -7,13 +7,14 @@
 #include <fstream>
 
 #include "core/common/errors.h"
-#include "server/test/error_of.h"
+#include "core/testing/error_of.h"
 
 namespace tubepick::server {
 namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using tubepick::testing::ErrorOf;
 namespace fs = std::filesystem;
 
 std::string ParseError(const std::string& yaml) {

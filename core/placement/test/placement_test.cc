@@ -10,6 +10,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/types.h"
+#include "core/testing/error_of.h"
 
 namespace tubepick {
 namespace {
@@ -53,15 +54,7 @@ Eigen::Matrix3d Rz(double angle) {
   return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "<no InvalidArgument thrown>";
-}
+using tubepick::testing::ErrorOf;
 
 TEST(PlacementFrame, StraightTubeAlongDiagonal) {
   const Eigen::Vector3d centre(0.05, -0.1, 0.03);

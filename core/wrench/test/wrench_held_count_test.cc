@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/common/errors.h"
+#include "core/testing/error_of.h"
 #include "core/wrench/wrench.h"
 #include "core/wrench/wrench_params.h"
 
@@ -32,15 +33,7 @@ WrenchParams ExactParams() {
   return params;
 }
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "<no InvalidArgument thrown>";
-}
+using tubepick::testing::ErrorOf;
 
 TEST(HeldCount, ExpectedForceIsSingle) {
   const HeldCount result = CountHeldTubes(kReference, kExpected, kMass, ExactParams());

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "core/common/errors.h"
+#include "core/testing/error_of.h"
 #include "core/wrench/wrench.h"
 #include "core/wrench/wrench_params.h"
 
@@ -42,15 +43,7 @@ Eigen::Matrix3d Rotation(double angle, const Eigen::Vector3d& axis) {
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
 }
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "<no InvalidArgument thrown>";
-}
+using tubepick::testing::ErrorOf;
 
 TEST(ResolutionRotation, TorqueAlongYGivesAxisYAnd45Degrees) {
   const WrenchParams params;
