@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 #include "wire/packed_cloud.h"
 #include "wire/proto_convert.h"
 
@@ -23,20 +24,10 @@ constexpr double kMaxTubeLength = 10.0;  // m
 constexpr double kMinTubeMass = 0.001;   // kg
 constexpr double kMaxTubeMass = 50.0;
 
-std::string Num(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.9g", value);
-  return buffer;
-}
-
 std::string Degrees(double radians) {
   char buffer[40];
   std::snprintf(buffer, sizeof(buffer), "%.1f deg", radians * 180.0 / M_PI);
   return buffer;
-}
-
-void RequireFiniteField(double value, const std::string& field) {
-  if (!std::isfinite(value)) throw InvalidArgument(field + ": must be finite, got " + Num(value));
 }
 
 // lo < value ≤ hi (lo_open) or lo ≤ value ≤ hi.
@@ -45,8 +36,8 @@ void RequireRange(double value, double lo, double hi, bool lo_open, const std::s
   RequireFiniteField(value, field);
   const bool ok = (lo_open ? value > lo : value >= lo) && value <= hi;
   if (!ok) {
-    throw InvalidArgument(field + ": " + Num(value) + " " + unit + " is out of range " +
-                          (lo_open ? "(" : "[") + Num(lo) + ", " + Num(hi) + "] " + unit);
+    throw InvalidArgument(field + ": " + FormatNumber(value) + " " + unit + " is out of range " +
+                          (lo_open ? "(" : "[") + FormatNumber(lo) + ", " + FormatNumber(hi) + "] " + unit);
   }
 }
 
@@ -106,9 +97,9 @@ void RequireTubeFitsGripper(const PlanningJob& job, bool cell_in_request, const 
   if (!(opening > 2.0 * job.cell.tube.radius)) {
     throw InvalidArgument(
         (cell_in_request ? prefix + "cell.tube_radius: " : "cell.tube_radius (the server's cell): ") +
-        Num(job.cell.tube.radius) + " m: a tube of diameter " + Num(2.0 * job.cell.tube.radius) +
-        " m does not fit the gripper opening " + Num(opening) + " m (profile '" + job.profile +
-        "', planning.grasps.opening_width)");
+        FormatNumber(job.cell.tube.radius) + " m: a tube of diameter " +
+        FormatNumber(2.0 * job.cell.tube.radius) + " m does not fit the gripper opening " +
+        FormatNumber(opening) + " m (profile '" + job.profile + "', planning.grasps.opening_width)");
   }
 }
 
@@ -158,7 +149,7 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   out.sensor.X_BinSensor = FromProto(cell->sensor_pose(), f + "sensor_pose");
   if (!(out.sensor.X_BinSensor.translation().z() > 0.0)) {
     throw InvalidArgument(f + "sensor_pose.position.z: the sensor must be above the bin floor (z > 0), got " +
-                          Num(out.sensor.X_BinSensor.translation().z()) + " m");
+                          FormatNumber(out.sensor.X_BinSensor.translation().z()) + " m");
   }
 
   RequireRange(cell->tube_radius(), kMinTubeRadius, kMaxTubeRadius, false, f + "tube_radius", "m");
@@ -261,8 +252,9 @@ WrenchJob ValidateAnalyzeWrench(const v1::AnalyzeWrenchRequest& request, const P
 
   const double weight = job.tube_mass * job.params.gravity;
   if (!(job.params.force_tolerance < weight)) {
-    throw InvalidArgument("tube_mass: " + Num(job.tube_mass) + " kg weighs " + Num(weight) +
-                          " N, not more than wrench.force_tolerance " + Num(job.params.force_tolerance) +
+    throw InvalidArgument("tube_mass: " + FormatNumber(job.tube_mass) + " kg weighs " + FormatNumber(weight) +
+                          " N, not more than wrench.force_tolerance " +
+                          FormatNumber(job.params.force_tolerance) +
                           " N: one tube could not be told from none" +
                           (request.has_tube_mass() ? "" : " (the server's cell tube mass)"));
   }

@@ -3,26 +3,16 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 #include "core/common/errors.h"
+#include "core/common/require.h"
 
 namespace tubepick {
 namespace {
 
 // Largest |‖q‖ − 1| of a quaternion accepted (and then normalised).
 constexpr double kQuaternionTol = 1e-3;
-
-std::string Num(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.9g", value);
-  return buffer;
-}
-
-void RequireFiniteField(double value, const std::string& field) {
-  if (!std::isfinite(value)) throw InvalidArgument(field + ": must be finite, got " + Num(value));
-}
 
 // A unit quaternion within kQuaternionTol, normalised; a zero or far-from-unit quaternion is an error.
 Eigen::Quaterniond FromProto(const v1::Quaternion& q, const std::string& field) {
@@ -33,9 +23,10 @@ Eigen::Quaterniond FromProto(const v1::Quaternion& q, const std::string& field) 
   const Eigen::Quaterniond rotation(q.w(), q.x(), q.y(), q.z());
   const double norm = rotation.norm();
   if (!(std::abs(norm - 1.0) <= kQuaternionTol)) {
-    throw InvalidArgument(field + ": quaternion (x, y, z, w) = (" + Num(q.x()) + ", " + Num(q.y()) + ", " +
-                          Num(q.z()) + ", " + Num(q.w()) + ") is not unit length: |q| = " + Num(norm) +
-                          " (tolerance 1e-3)" + (norm == 0.0 ? "; an absent orientation is all zeros" : ""));
+    throw InvalidArgument(field + ": quaternion (x, y, z, w) = (" + FormatNumber(q.x()) + ", " +
+                          FormatNumber(q.y()) + ", " + FormatNumber(q.z()) + ", " + FormatNumber(q.w()) +
+                          ") is not unit length: |q| = " + FormatNumber(norm) + " (tolerance 1e-3)" +
+                          (norm == 0.0 ? "; an absent orientation is all zeros" : ""));
   }
   return rotation.normalized();
 }

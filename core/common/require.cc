@@ -1,6 +1,7 @@
 #include "core/common/require.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "core/common/errors.h"
@@ -16,6 +17,16 @@ constexpr double kOrthonormalTol = 1e-6;
 void RequireFinite(double value, const std::string& key) {
   if (!std::isfinite(value))
     throw InvalidArgument(key + ": value must be finite, got " + std::to_string(value));
+}
+
+std::string FormatNumber(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.9g", value);
+  return buffer;
+}
+
+void RequireFiniteField(double value, const std::string& field) {
+  if (!std::isfinite(value)) throw InvalidArgument(field + ": must be finite, got " + FormatNumber(value));
 }
 
 void RequirePositive(double value, const std::string& key) {

@@ -14,6 +14,13 @@ namespace tubepick {
 /// @throws InvalidArgument "<key>: value must be finite, got <value>" for NaN or ±inf.
 void RequireFinite(double value, const std::string& key);
 
+/// `value` as messages about request fields print numbers ("%.9g": 0.1, 1e+30, nan).
+std::string FormatNumber(double value);
+
+/// The check of a request field (wire/, server/): @throws InvalidArgument
+/// "<field>: must be finite, got <FormatNumber(value)>" for NaN or ±inf.
+void RequireFiniteField(double value, const std::string& field);
+
 /// @throws InvalidArgument unless `value` is finite and > 0.
 void RequirePositive(double value, const std::string& key);
 
