@@ -132,6 +132,18 @@ void DescribeFields(Visit& v, JoiningParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, PlausibilityParams& p) {
+  v("check", p.check, "false: no error for a cloud that misses the bin");
+  v("margin_xy", p.margin_xy, "bin volume: inner x/y extent grown by this, m");
+  v("below_floor", p.below_floor, "bin volume: from this far below the floor, m");
+  v("above_walls", p.above_walls, "bin volume: to this far above the walls, m");
+  v("min_inside_share", p.min_inside_share, "of the finite points, inside the bin volume");
+  v("floor_tolerance", p.floor_tolerance, "on the floor: |z| at most this, m");
+  v("min_floor_points", p.min_floor_points, "floor seen: at least this many points on it");
+  v("min_floor_share", p.min_floor_share, "and this share of the points inside the bin volume");
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, ModelingParams& p) {
   v("threads", p.threads, "0 = all cores");
   v.VariantList("filters", p.filters, internal::FilterListSpec(), "applied in order, bin frame");
@@ -139,6 +151,7 @@ void DescribeFields(Visit& v, ModelingParams& p) {
   v.Section("segmentation", p.segmentation);
   v.Section("cylinders", p.cylinders);
   v.Section("joining", p.joining);
+  v.Section("plausibility", p.plausibility);
 }
 
 // ---- planning, wrench, placement --------------------------------------------------------------

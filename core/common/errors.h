@@ -12,6 +12,14 @@ class InvalidArgument : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// The input is well formed but does not fit the cell it is meant for: e.g. a cloud whose unit or
+/// sensor pose is wrong, so that it misses the bin. The message gives the evidence and the likely
+/// cause; the server maps it to gRPC FAILED_PRECONDITION, the CLI to exit code 4.
+class FailedPrecondition : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// The caller cancelled the work or its deadline passed (see StopToken).
 class Cancelled : public std::runtime_error {
  public:

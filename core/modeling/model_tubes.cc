@@ -79,6 +79,8 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   result.raw_Bin = std::move(prepared.points_Bin);
   result.counts.push_back({"input", result.input_points});
   result.counts.push_back({"finite", result.raw_Bin.size()});
+  result.plausibility =
+      RequirePlausibleCloud(result.raw_Bin, input.bin, input.unit, input.X_BinSensor, params.plausibility);
   result.timings.push_back({"prepare", SecondsSince(t0)});
   ThrowIfStopped(stop, "prepare");
 

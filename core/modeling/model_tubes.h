@@ -7,6 +7,7 @@
 #include "core/common/cell_config.h"
 #include "core/common/stop_token.h"
 #include "core/common/types.h"
+#include "core/modeling/cloud_plausibility.h"
 #include "core/modeling/modeling_params.h"
 
 namespace tubepick {
@@ -37,6 +38,8 @@ struct ModelingResult {
   double max_height = 0.0;
   std::uint64_t input_points = 0;
   std::uint64_t dropped_non_finite = 0;
+  /// How the finite input fits the bin (points inside, floor seen, extent).
+  CloudPlausibility plausibility;
   std::uint32_t segment_count = 0;
   std::uint32_t cylinder_count = 0;
   std::vector<StepCount> counts;
@@ -58,6 +61,8 @@ struct ModelingResult {
 
 /// Runs Algorithm 1: prepare → filters (+ normals) → region growing → cylinders → joining.
 /// @throws InvalidArgument for an empty / all-non-finite cloud or invalid parameters.
+/// @throws FailedPrecondition when the cloud in the bin frame does not look like the cell (wrong
+///         unit or sensor pose; see RequirePlausibleCloud and params.plausibility).
 /// @throws Cancelled when `stop` fires (polled inside every stage).
 ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params,
                           const StopToken* stop = nullptr);

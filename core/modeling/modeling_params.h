@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/modeling/cloud_plausibility.h"
 #include "core/modeling/cylinder_fit.h"
 #include "core/modeling/filters.h"
 #include "core/modeling/normals.h"
@@ -21,6 +22,8 @@ struct ModelingParams {
   SegmentationParams segmentation;
   CylinderFitParams cylinders;
   JoiningParams joining;
+  /// The check, right after the cloud enters the bin frame, that it looks like the cell.
+  PlausibilityParams plausibility;
   /// Worker threads for normals and per-segment fitting; 0 = all cores. Results do not depend
   /// on it.
   std::uint32_t threads = 0;

@@ -125,6 +125,8 @@ void PlanningParams::Validate() const {
 
 bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params) {
   if (!modeling.tubes.empty()) return false;
+  // Nothing standing on a floor that is not seen is no evidence of an empty bin.
+  if (!modeling.plausibility.floor_seen) return false;
   std::uint32_t above = 0;
   for (const Eigen::Vector3f& p : modeling.filtered.points) {
     if (p.z() > params.empty_min_height && ++above > params.empty_max_points) return false;

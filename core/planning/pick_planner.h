@@ -85,7 +85,8 @@ struct PickPlanResult {
   double total_seconds = 0.0;
 };
 
-/// The bin-empty rule: no tube modeled and at most `empty_max_points` filtered points above
+/// The bin-empty rule: the bin floor seen (modeling.plausibility.floor_seen), no tube modeled and
+/// at most `empty_max_points` filtered points above
 /// `empty_min_height` (the filtered cloud holds only bin content: floor, walls and outside were
 /// cropped by modeling; the height threshold absorbs floor points a loose crop kept).
 bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params);

@@ -224,6 +224,7 @@ TEST(PickPlanner, TooShortTubesAreObstaclesOnly) {
 TEST(PickPlanner, BinEmpty) {
   PlanningParams params;  // empty: ≤ 50 filtered points above 5 mm
   ModelingResult empty = Model({});
+  empty.plausibility.floor_seen = true;
   for (int i = 0; i < 40; ++i) empty.filtered.points.emplace_back(0.0f, 0.0f, 0.03f);    // stray points
   for (int i = 0; i < 500; ++i) empty.filtered.points.emplace_back(0.0f, 0.0f, 0.002f);  // floor
   const PickPlanResult r = PlanPick(empty, CellConfig{}, params, nullptr, 0);
@@ -236,6 +237,10 @@ TEST(PickPlanner, BinEmpty) {
   EXPECT_FALSE(IsBinEmpty(clutter, params));
   EXPECT_FALSE(PlanPick(Model(CrossingTubes()), CellConfig{}, params, nullptr, 0).bin_empty);
   EXPECT_FALSE(IsBinEmpty(Model({MakeTube(0, {FlatCylinder(0, 0, 0.05, 0, 1)})}), params));
+
+  ModelingResult no_floor = empty;  // nothing stands on a floor that was not seen: not empty
+  no_floor.plausibility.floor_seen = false;
+  EXPECT_FALSE(IsBinEmpty(no_floor, params));
 }
 
 TEST(PickPlanner, MaxPlans) {
