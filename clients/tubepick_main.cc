@@ -38,6 +38,9 @@ int main(int argc, char** argv) {
   } catch (const tubepick::InvalidArgument& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;
+  } catch (const tubepick::FailedPrecondition& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return 4;  // 3 is tubepick cell's "a round ended in a fault"
   } catch (const std::exception& e) {
     fmt::print(stderr, "internal error: {}\n", e.what());
     return 1;

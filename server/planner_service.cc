@@ -279,6 +279,8 @@ grpc::Status PlannerService::RunOnWorker(CallState& call, Clock::time_point enqu
     status = call.CancelledStatus(e.what());
   } catch (const InvalidArgument& e) {
     status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const FailedPrecondition& e) {
+    status = grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, e.what());
   } catch (const std::exception& e) {
     spdlog::error("{} {}: internal error: {}", call.record.rpc, call.record.request_id, e.what());
     status = grpc::Status(grpc::StatusCode::INTERNAL,

@@ -25,7 +25,8 @@ namespace tubepick::server {
 ///   progress count against admission and memory) and gives it back when it fails. Validation and
 ///   work run on the worker; a call whose deadline passed (or that was cancelled) while queued is
 ///   dropped without running. AnalyzeWrench is microseconds of arithmetic and runs inline;
-/// - errors map as: InvalidArgument → INVALID_ARGUMENT (its message), Cancelled → CANCELLED or
+/// - errors map as: InvalidArgument → INVALID_ARGUMENT (its message), FailedPrecondition (a cloud
+///   that misses the bin) → FAILED_PRECONDITION (its message), Cancelled → CANCELLED or
 ///   DEADLINE_EXCEEDED, anything else → INTERNAL (logged with the request id).
 class PlannerService final : public v1::PickPlannerService::CallbackService {
  public:

@@ -82,6 +82,33 @@ TEST(CliModel, BadInputsGiveClearErrors) {
   fs::remove_all(dir);
 }
 
+TEST(CliModel, ACloudThatMissesTheBinIsExitCode4NeverBinEmpty) {
+  const fs::path dir = TempDir("misfit");
+  const auto cloud =
+      testing::RenderSyntheticCloud({testing::FloorTube({{-0.2, 0.0}, {0.2, 0.0}})}, {.pixel_angle = 0.002});
+  WritePly((dir / "m.ply").string(), cloud.points_Sensor);  // metres
+  for (const std::string command : {"model", "plan"}) {
+    // Metres read as millimetres: the cloud shrinks to 1 mm at the sensor.
+    CliRun run = RunCli(command + " --cloud " + (dir / "m.ply").string() + " --unit mm");
+    EXPECT_EQ(run.exit_code, 4) << run.output;
+    EXPECT_THAT(run.output, HasSubstr("error: cloud does not fit the cell: 0 of "));
+    EXPECT_THAT(run.output, HasSubstr("is the unit m rather than mm (cloud.unit / --unit)?"));
+    EXPECT_THAT(run.output, ::testing::Not(HasSubstr("BIN EMPTY")));
+  }
+  // A cell whose sensor pose is 0.5 m too high.
+  {
+    std::ofstream(dir / "cell.yaml") << "sensor:\n  pose_in_bin:\n    position: [0, 0, 1.6]\n"
+                                        "    orientation_xyzw: [1, 0, 0, 0]\n";
+  }
+  CliRun run = RunCli("plan --cloud " + (dir / "m.ply").string() + " --cell " + (dir / "cell.yaml").string());
+  EXPECT_EQ(run.exit_code, 4) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("is the sensor pose right (sensor.pose_in_bin, X_BinSensor)?"));
+  // The right unit and cell: models normally.
+  run = RunCli("model --cloud " + (dir / "m.ply").string() + " --unit m");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  fs::remove_all(dir);
+}
+
 TEST(CliPlan, PlansTheBuiltInSceneAndWritesPlanPickResponse) {
   const fs::path dir = TempDir("plan");
   const CliRun run = RunCli("plan --tubes 4 --seed 2 --json " + (dir / "plan.json").string());

@@ -296,7 +296,8 @@ TEST_F(ServiceRpc, AFullyGivenCellIsUsed) {
 
 TEST_F(ServiceRpc, GarbageCloudsNeverCrashTheServer) {
   // Random bytes (NaNs, infinities, 1e38 coordinates, denormals) and all-NaN clouds: each answer is
-  // OK or INVALID_ARGUMENT, never INTERNAL, and the server keeps serving.
+  // OK, INVALID_ARGUMENT or (a cloud that misses the bin) FAILED_PRECONDITION, never INTERNAL, and
+  // the server keeps serving.
   std::mt19937_64 rng(5);
   std::vector<std::string> clouds;
   for (int i = 0; i < 3; ++i) {
@@ -311,7 +312,8 @@ TEST_F(ServiceRpc, GarbageCloudsNeverCrashTheServer) {
   for (const std::string& cloud : clouds) {
     v1::PlanPickResponse response;
     const grpc::Status status = PlanPick(PlanRequest(cloud), &response);
-    EXPECT_TRUE(status.ok() || status.error_code() == grpc::StatusCode::INVALID_ARGUMENT)
+    EXPECT_TRUE(status.ok() || status.error_code() == grpc::StatusCode::INVALID_ARGUMENT ||
+                status.error_code() == grpc::StatusCode::FAILED_PRECONDITION)
         << status.error_code() << ": " << status.error_message();
     if (status.ok()) {
       EXPECT_EQ(response.tubes_size(), 0);
@@ -320,6 +322,68 @@ TEST_F(ServiceRpc, GarbageCloudsNeverCrashTheServer) {
   v1::ModelTubesResponse response;
   ASSERT_TRUE(ModelTubes(ModelRequest(ThreeTubeCloud()), &response).ok());
   EXPECT_EQ(response.tubes_size(), 3);
+}
+
+// --- clouds that do not fit the cell: FAILED_PRECONDITION, never "bin empty" -----------------------
+
+void ExpectMisfit(const grpc::Status& status, const std::string& cause) {
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("cloud does not fit the cell: 0 of "));
+  EXPECT_THAT(status.error_message(), HasSubstr(cause));
+}
+
+std::string ScaledCloud(const std::string& xyz, float factor) {
+  std::string out = xyz;
+  for (std::size_t i = 0; i + 4 <= out.size(); i += 4) {
+    float v;
+    std::memcpy(&v, out.data() + i, 4);
+    v *= factor;
+    std::memcpy(out.data() + i, &v, 4);
+  }
+  return out;
+}
+
+TEST_F(ServiceRpc, MetresSentAsMillimetresIsAFailedPrecondition) {
+  v1::ModelTubesRequest model = ModelRequest(ThreeTubeCloud());
+  model.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);
+  ExpectMisfit(ModelTubes(model), "is the unit m rather than mm");
+
+  v1::PlanPickRequest plan = PlanRequest(ThreeTubeCloud());
+  plan.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);
+  v1::PlanPickResponse response;
+  ExpectMisfit(PlanPick(plan, &response), "is the unit m rather than mm");
+  EXPECT_FALSE(response.bin_empty());
+}
+
+TEST_F(ServiceRpc, MillimetresSentAsMetresIsAFailedPrecondition) {
+  const std::string mm = ScaledCloud(ThreeTubeCloud(), 1000.0f);
+  ExpectMisfit(PlanPick(PlanRequest(mm)), "is the unit mm rather than m");
+  v1::PlanPickRequest right = PlanRequest(mm);
+  right.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);
+  v1::PlanPickResponse response;
+  ASSERT_TRUE(PlanPick(right, &response).ok());
+  EXPECT_EQ(response.tubes_size(), 3);
+}
+
+TEST_F(ServiceRpc, AWrongSensorPoseIsAFailedPrecondition) {
+  v1::PlanPickRequest flipped = PlanRequest(ThreeTubeCloud());
+  *flipped.mutable_cell() = DefaultCell();
+  SetPose(flipped.mutable_cell()->mutable_sensor_pose(), 0.0, 0.0, 1.1, 0.0, 0.0, 0.0, 1.0);  // looks up
+  ExpectMisfit(PlanPick(flipped), "is the sensor pose right (sensor.pose_in_bin, X_BinSensor)?");
+
+  v1::ModelTubesRequest shifted = ModelRequest(ThreeTubeCloud());
+  *shifted.mutable_cell() = DefaultCell();
+  SetPose(shifted.mutable_cell()->mutable_sensor_pose(), 0.0, 0.0, 1.6, 1.0, 0.0, 0.0, 0.0);  // 0.5 m up
+  ExpectMisfit(ModelTubes(shifted), "puts the sensor at (0.000, 0.000, 1.600) m");
+}
+
+TEST_F(ServiceRpc, AnEmptyBinIsBinEmpty) {
+  v1::PlanPickResponse response;
+  const grpc::Status status = PlanPick(PlanRequest(EmptyBinCloud()), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_TRUE(response.bin_empty());
+  EXPECT_EQ(response.tubes_size(), 0);
+  EXPECT_EQ(response.plans_size(), 0);
 }
 
 TEST(ServiceLimits, AMessageOverTheSizeLimitIsResourceExhausted) {

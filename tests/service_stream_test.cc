@@ -83,6 +83,16 @@ TEST_F(ServiceStream, OutOfOrderChunksAreJoinedByIndex) {
   EXPECT_GT(streamed.response.response().plans_size(), 0);
 }
 
+TEST_F(ServiceStream, AWrongUnitIsAFailedPrecondition) {
+  v1::PlanPickRequest header = PlanRequest("");
+  header.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);  // the cloud is in metres
+  const StreamResult streamed =
+      SendStream(server_->stub(), SplitCloudStream(header, ThreeTubeCloud(), kChunk));
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("cloud does not fit the cell: 0 of "));
+  EXPECT_THAT(streamed.status.error_message(), HasSubstr("is the unit m rather than mm"));
+}
+
 TEST_F(ServiceStream, AMissingChunkIsInvalid) {
   auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
   messages.erase(messages.begin() + 3);  // chunk 2

@@ -227,6 +227,16 @@ const std::string& ThreeTubeCloud() {
   return cloud;
 }
 
+const std::string& EmptyBinCloud() {
+  static const std::string cloud = [] {
+    tubepick::testing::SyntheticCloudParams params;
+    params.pixel_angle = 0.002;
+    params.seed = 4;
+    return PackCloud(tubepick::testing::RenderSyntheticCloud({}, params).points_Sensor);
+  }();
+  return cloud;
+}
+
 const std::string& BusyBinCloud() {
   static const std::string cloud = [] {
     const CellConfig cell;

@@ -50,6 +50,9 @@ std::string PackCloud(const Points& points);
 /// Three separate straight tubes (0.30, 0.26 and 0.22 m) lying on the bin floor, seen by the default
 /// sensor (no floor points, 1 mm pixels): about 20 k points. Cached.
 const std::string& ThreeTubeCloud();
+/// The empty bin: the floor only, seen by the default sensor (2.2 mm pixels): about 100 k points.
+/// Cached.
+const std::string& EmptyBinCloud();
 /// A generated bin of 8 tubes (physics drop + virtual scan, default cell), about 1 M points: the
 /// "slow" request of the cancellation and admission tests (thesis profile, simulation on). Cached.
 const std::string& BusyBinCloud();
