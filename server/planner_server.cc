@@ -4,6 +4,7 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/impl/server_builder_option.h>
 #include <spdlog/spdlog.h>
 
 #include <climits>
@@ -22,6 +23,18 @@
 
 namespace tubepick::server {
 namespace {
+
+/// Takes gRPC's reflection plugin off one server (`server.reflection: false`). The plugin is
+/// registered process-wide (InitProtoReflectionServerBuilderPlugin), so the switch is per builder.
+class WithoutReflection final : public grpc::ServerBuilderOption {
+ public:
+  void UpdateArguments(grpc::ChannelArguments* /*args*/) override {}
+  void UpdatePlugins(std::vector<std::unique_ptr<grpc::ServerBuilderPlugin>>* plugins) override {
+    std::erase_if(*plugins, [](const std::unique_ptr<grpc::ServerBuilderPlugin>& plugin) {
+      return plugin->name() == "proto_server_reflection";
+    });
+  }
+};
 
 constexpr const char* kServiceName = "tubepick.v1.PickPlannerService";
 
@@ -111,6 +124,7 @@ void PlannerServer::Start() {
   m.service = std::make_unique<PlannerService>(config, m.pool.get(), m.metrics.get());
 
   grpc::ServerBuilder builder;
+  if (!config.reflection) builder.SetOption(std::make_unique<WithoutReflection>());
   builder.AddListeningPort(config.address, MakeCredentials(config.tls), &m.port);
   builder.SetMaxReceiveMessageSize(ClampToInt(config.max_message_bytes));
   builder.SetMaxSendMessageSize(ClampToInt(config.max_message_bytes));

@@ -102,7 +102,9 @@ struct SimulationSection {
 template <typename Visit>
 void DescribeFields(Visit& v, ServerSection& section) {
   ServerConfig& c = section.config;
-  v("address", c.address, "gRPC listen address, HOST:PORT; port 0 = any free port; IPv6 as \"[::]:50051\".");
+  v("address", c.address,
+    "gRPC listen address, HOST:PORT (port 0 = any, IPv6 \"[::]:50051\"); \"0.0.0.0:50051\" = all "
+    "interfaces.");
   v("workers", c.workers, "Planning worker threads; 0 = one per hardware thread.");
   v("queue_capacity", c.queue_capacity,
     "Admitted calls that may wait for a free worker; more are answered RESOURCE_EXHAUSTED. >= 1.");
@@ -112,7 +114,9 @@ void DescribeFields(Visit& v, ServerSection& section) {
     "Largest cloud a PlanPickStream header may announce, bytes: 512 MiB.");
   v("shutdown_grace", c.shutdown_grace,
     "On SIGTERM, in-flight calls get this long to finish before they are cancelled, seconds.");
-  v("metrics_address", c.metrics_address, "Prometheus text metrics at http://HOST:PORT/metrics; \"\" = off.");
+  v("metrics_address", c.metrics_address,
+    "Prometheus text metrics at http://HOST:PORT/metrics; \"\" = off. Bind an internal address only.");
+  v("reflection", c.reflection, "gRPC server reflection (buf curl, grpcurl); false publishes no schema.");
   v("log_level", c.log_level, "trace, debug, info, warn, error, critical or off.");
   v("log_format", c.log_format, "text, or json (one JSON object per line).");
   v.Section("tls", c.tls);

@@ -51,8 +51,9 @@ struct PlanningDefaults {
 /// The whole server configuration (`tubepick-server --config FILE`; EmbeddedServerConfigYaml() is the
 /// default). Every key is optional; unknown keys are errors.
 struct ServerConfig {
-  /// gRPC listen address, HOST:PORT (port 0 = any free port).
-  std::string address = "0.0.0.0:50051";
+  /// gRPC listen address, HOST:PORT (port 0 = any free port). Loopback by default: a plant network
+  /// is reached only when the deployment says so (the Docker image passes 0.0.0.0).
+  std::string address = "127.0.0.1:50051";
   /// Planning worker threads; 0 = hardware threads.
   std::uint32_t workers = 0;
   /// Admitted requests that may wait for a worker; beyond that RESOURCE_EXHAUSTED.
@@ -63,8 +64,11 @@ struct ServerConfig {
   std::uint64_t max_stream_bytes = 512ull << 20;
   /// SIGTERM: in-flight calls get this long to finish, then are cancelled, seconds.
   double shutdown_grace = 10.0;
-  /// Prometheus text metrics over HTTP at HOST:PORT/metrics; empty = off.
-  std::string metrics_address = "0.0.0.0:9464";
+  /// Prometheus text metrics over HTTP at HOST:PORT/metrics; empty = off. Loopback by default.
+  std::string metrics_address = "127.0.0.1:9464";
+  /// gRPC server reflection (what `buf curl` and grpcurl list and describe); off in production
+  /// profiles that publish no schema.
+  bool reflection = true;
   /// spdlog level name: trace, debug, info, warn, error, critical, off.
   std::string log_level = "info";
   /// "text" or "json" (one JSON object per line).

@@ -153,4 +153,25 @@ set -e
 SERVER_PID=""
 [ "$rc" -eq 0 ] || fail "server exit code $rc after SIGTERM, expected 0"
 step "SIGTERM: exit 0"
+
+# --- reflection off (production profile) ---------------------------------------------------------
+printf 'server:\n  reflection: false\n  metrics_address: ""\n' >"$WORK/no-reflection.yaml"
+"$SERVER" --config "$WORK/no-reflection.yaml" --address 127.0.0.1:0 --workers 1 >"$WORK/server.log" 2>&1 &
+SERVER_PID=$!
+PORT=""
+for _ in $(seq 1 300); do
+  PORT=$(sed -n 's/.*listening on 127\.0\.0\.1:\([0-9][0-9]*\).*/\1/p' "$WORK/server.log" | head -n 1)
+  [ -n "$PORT" ] && break
+  kill -0 "$SERVER_PID" 2>/dev/null || fail "server with reflection off exited during start-up"
+  sleep 0.1
+done
+[ -n "$PORT" ] || fail "server with reflection off: no 'listening on' line within 30 s"
+if bufcurl --list-methods "http://127.0.0.1:$PORT" >"$WORK/methods-off.txt" 2>&1; then
+  fail "reflection: false still lists methods: $(tr '\n' ' ' <"$WORK/methods-off.txt")"
+fi
+"$CLI" health --target "127.0.0.1:$PORT" >"$WORK/health-off.txt" 2>&1 || fail "health with reflection off"
+kill -TERM "$SERVER_PID"
+wait "$SERVER_PID" || fail "server with reflection off: non-zero exit after SIGTERM"
+SERVER_PID=""
+step "reflection: false lists nothing; health still SERVING"
 echo "smoke: all checks passed"

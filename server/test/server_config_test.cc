@@ -109,6 +109,17 @@ TEST(ServerConfig, DefaultsHaveBothProfilesAndValidate) {
   EXPECT_EQ(config.max_message_bytes, 64u << 20);
 }
 
+TEST(ServerConfig, DefaultsListenOnLoopbackOnly) {
+  // A server started with no config must not be reachable from the plant network by accident.
+  const ServerConfig config;
+  EXPECT_EQ(config.address, "127.0.0.1:50051");
+  EXPECT_EQ(config.metrics_address, "127.0.0.1:9464");
+  EXPECT_TRUE(config.reflection);
+  const ServerConfig embedded = ParseServerConfig(std::string(EmbeddedServerConfigYaml()), ".");
+  EXPECT_EQ(embedded.address, "127.0.0.1:50051");
+  EXPECT_EQ(embedded.metrics_address, "127.0.0.1:9464");
+}
+
 TEST(ServerConfig, EmbeddedYamlParsesToExactlyTheDefaults) {
   const std::string yaml(EmbeddedServerConfigYaml());
   // Every section is spelled out (an operator copies it as a template).
@@ -138,6 +149,7 @@ server:
   max_stream_bytes: 1200
   shutdown_grace: 2.5
   metrics_address: ""
+  reflection: false
   log_level: debug
   log_format: json
   tls: {cert_file: tls/server.pem, key_file: tls/server.key, client_ca_file: tls/ca.pem,
@@ -151,6 +163,7 @@ planning:
 )",
                                            dir.string());
   EXPECT_EQ(c.address, "[::1]:6000");
+  EXPECT_FALSE(c.reflection);
   EXPECT_EQ(c.workers, 3u);
   EXPECT_EQ(c.queue_capacity, 2u);
   EXPECT_EQ(c.max_message_bytes, 2097152u);
