@@ -126,6 +126,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   StreamCall(PlannerService* service, grpc::CallbackServerContext* context,
              v1::PlanPickStreamResponse* response)
       : service_(service),
+        context_(context),
         state_(context, "PlanPickStream"),
         response_(response),
         assembler_(service->config_.max_stream_bytes) {
@@ -166,10 +167,14 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   }
 
  private:
-  // The client half-closed (or the call broke): run the plan on the reserved slot.
+  // The client half-closed, or the call broke: a complete upload runs on the reserved slot; a
+  // broken one (the client cancelled, its deadline passed, the connection dropped) is CANCELLED or
+  // DEADLINE_EXCEEDED, and a half-closed incomplete one is INVALID_ARGUMENT, without a worker.
   void UploadEnded() {
-    if (state_.token.should_stop()) {
-      Answer(state_.CancelledStatus("stopped while the cloud was uploading"));
+    if (state_.token.should_stop() || context_->IsCancelled()) {
+      state_.MarkCancelled();
+      Answer(state_.CancelledStatus(fmt::format("stopped while the cloud was uploading ({} bytes received)",
+                                                assembler_.received_bytes())));
       return;
     }
     if (!assembler_.has_header()) {
@@ -177,15 +182,18 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
                           "PlanPickStream ended before its header: the first message must be a header"));
       return;
     }
+    try {
+      cloud_ = assembler_.Finish();  // cheap: checks chunks, size and CRC, moves the joined bytes
+    } catch (const InvalidArgument& e) {
+      Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what()));
+      return;
+    }
     const Clock::time_point enqueued = Clock::now();
     const WorkerPool::Admission admission =
         service_->pool_->Submit(std::move(reservation_), [this, enqueued] {
           const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
-            PlanningJob job;
-            {
-              const std::string cloud = assembler_.Finish();  // checks chunks, size, CRC
-              job = ValidatePlanPick(assembler_.request(), cloud, service_->config_.planning);
-            }
+            PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
+            std::string().swap(cloud_);  // the decoded points are all that is needed now
             state_.record.points = job.points_Sensor.size();
             *response_->mutable_response() =
                 RunPlanPick(job, service_->config_.planning,
@@ -205,10 +213,13 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   }
 
   PlannerService* service_;
+  grpc::CallbackServerContext* context_;
   CallState state_;
   v1::PlanPickStreamResponse* response_;
   v1::PlanPickStreamRequest message_;
   CloudStreamAssembler assembler_;
+  /// The joined cloud bytes of a complete upload, until the job has decoded them.
+  std::string cloud_;
   WorkerPool::Reservation reservation_;
 };
 

@@ -101,6 +101,38 @@ TEST_F(ServiceStream, AMissingChunkIsInvalid) {
   EXPECT_THAT(streamed.status.error_message(), HasSubstr("missing 2"));
 }
 
+TEST_F(ServiceStream, AnUploadTheClientAbandonsIsCancelledNotInvalid) {
+  // The header and two of six chunks, then the client cancels (a crashed cell controller, a
+  // dropped connection): the server must record CANCELLED, not "stream ended after 2 of 6 chunks".
+  const std::string series = R"(tubepick_rpc_requests_total{method="PlanPickStream",code="CANCELLED"})";
+  const double before = MetricValue(ScrapeMetrics(server_->metrics_port()), series).value_or(0.0);
+  const double invalid_before =
+      MetricValue(ScrapeMetrics(server_->metrics_port()),
+                  R"(tubepick_rpc_requests_total{method="PlanPickStream",code="INVALID_ARGUMENT"})")
+          .value_or(0.0);
+  const auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  {
+    grpc::ClientContext context;
+    SetTimeout(&context, std::chrono::seconds(60));
+    v1::PlanPickStreamResponse response;
+    std::unique_ptr<grpc::ClientWriter<v1::PlanPickStreamRequest>> writer =
+        server_->stub().PlanPickStream(&context, &response);
+    for (std::size_t i = 0; i < 3; ++i) ASSERT_TRUE(writer->Write(messages[i]));
+    context.TryCancel();
+    EXPECT_EQ(writer->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  }
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(ScrapeMetrics(server_->metrics_port()), series).value_or(0.0) == before + 1.0;
+      },
+      std::chrono::seconds(10)))
+      << ScrapeMetrics(server_->metrics_port());
+  EXPECT_EQ(MetricValue(ScrapeMetrics(server_->metrics_port()),
+                        R"(tubepick_rpc_requests_total{method="PlanPickStream",code="INVALID_ARGUMENT"})")
+                .value_or(0.0),
+            invalid_before);
+}
+
 TEST_F(ServiceStream, ADuplicateChunkIsInvalid) {
   auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
   messages.insert(messages.begin() + 3, messages[2]);
