@@ -2,7 +2,10 @@
 
 #include <malloc.h>
 
+#include <spdlog/spdlog.h>
+
 #include <cassert>
+#include <exception>
 #include <utility>
 
 namespace tubepick::server {
@@ -94,7 +97,7 @@ void WorkerPool::WorkerLoop() {
     queue_.pop_front();
     ++busy_;
     lock.unlock();
-    job();          // must not throw: jobs report their own errors (see PlannerService)
+    RunGuarded(job);
     job = nullptr;  // destroy captures outside the lock
 #ifdef __GLIBC__
     // Give the freed pages of this call back to the kernel (heap tops and whole free pages inside
@@ -104,6 +107,18 @@ void WorkerPool::WorkerLoop() {
 #endif
     lock.lock();
     --busy_;
+  }
+}
+
+void WorkerPool::RunGuarded(const Job& job) {
+  try {
+    job();
+  } catch (const std::exception& e) {
+    escaped_exceptions_.fetch_add(1);
+    spdlog::error("worker pool: a job threw (a bug; the worker goes on): {}", e.what());
+  } catch (...) {
+    escaped_exceptions_.fetch_add(1);
+    spdlog::error("worker pool: a job threw a non-standard exception (a bug; the worker goes on)");
   }
 }
 

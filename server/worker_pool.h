@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -29,7 +30,9 @@ struct PoolLoad {
 /// letting memory grow. Jobs run in FIFO order. Thread-safe.
 class WorkerPool {
  public:
-  /// A unit of work; must not throw (a throwing job terminates the process).
+  /// A unit of work. Jobs report their own errors (PlannerService answers every call itself); one
+  /// that throws anyway is a bug: it is logged and counted (escaped_exceptions), and the worker goes
+  /// on with the next job instead of terminating the process.
   using Job = std::function<void()>;
 
   /// `workers` ≥ 1 threads start at once.
@@ -69,12 +72,15 @@ class WorkerPool {
   PoolLoad load() const;
   std::uint32_t workers() const { return static_cast<std::uint32_t>(threads_.size()); }
   std::uint32_t queue_capacity() const { return queue_capacity_; }
+  /// Jobs that threw although jobs must not (each one logged as an error).
+  std::uint64_t escaped_exceptions() const { return escaped_exceptions_.load(); }
 
   /// Refuses new work, lets the workers finish what is queued, joins them. Idempotent.
   void Stop();
 
  private:
   void WorkerLoop();
+  void RunGuarded(const Job& job);
   bool HasRoomLocked() const;
   void ReleaseReservation();
 
@@ -85,6 +91,7 @@ class WorkerPool {
   std::uint32_t busy_ = 0;
   std::uint32_t reserved_ = 0;
   bool stopping_ = false;
+  std::atomic<std::uint64_t> escaped_exceptions_{0};
   std::mutex join_mu_;
   std::vector<std::thread> threads_;
 };

@@ -66,6 +66,17 @@ TEST(WorkerPool, AdmitsWorkersPlusQueueThenRefuses) {
   EXPECT_FALSE(pool.TryReserve());
 }
 
+TEST(WorkerPool, AJobThatThrowsDoesNotTakeTheWorkerOrTheProcessDown) {
+  WorkerPool pool(1, 2);
+  std::atomic<int> ran{0};
+  ASSERT_EQ(pool.TrySubmit([] { throw std::runtime_error("bug"); }), WorkerPool::Admission::kAdmitted);
+  ASSERT_EQ(pool.TrySubmit([] { throw 42; }), WorkerPool::Admission::kAdmitted);
+  ASSERT_EQ(pool.TrySubmit([&] { ++ran; }), WorkerPool::Admission::kAdmitted);
+  pool.Stop();  // runs what was queued, then joins
+  EXPECT_EQ(ran.load(), 1);
+  EXPECT_EQ(pool.escaped_exceptions(), 2u);
+}
+
 TEST(WorkerPool, RunsJobsInParallelOnItsWorkers) {
   WorkerPool pool(3, 0);
   std::atomic<int> inside{0}, peak{0};
