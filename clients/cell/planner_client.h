@@ -8,10 +8,10 @@
 
 #include <grpcpp/support/status.h>
 
-#include "wire/status_names.h"
 #include "tubepick/v1/planning.pb.h"
 #include "tubepick/v1/requests.pb.h"
 #include "tubepick/v1/wrench.pb.h"
+#include "wire/status_names.h"
 
 namespace tubepick::cell {
 
