@@ -145,6 +145,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
       assembler_.Add(message_);
       if (!had_header) {  // Add accepts nothing but a header first
         state_.record.points = announced / 12;
+        RequireAnnouncedPointsWithinLimit(announced);
         std::optional<WorkerPool::Reservation> slot = service_->pool_->TryReserve();
         if (!slot) {
           Answer(service_->Rejected(state_));
@@ -167,6 +168,18 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   }
 
  private:
+  // The point limit of planning.max_cloud_points, checked at the header (as DecodeCloud checks a
+  // unary request's cloud), before anything is admitted or reserved.
+  void RequireAnnouncedPointsWithinLimit(std::uint64_t announced_bytes) const {
+    const std::uint64_t limit = service_->config_.planning.max_cloud_points;
+    if (announced_bytes / 12 > limit) {
+      throw InvalidArgument(
+          fmt::format("header.total_bytes: {} bytes announce {} points, more than the limit of {} "
+                      "(planning.max_cloud_points)",
+                      announced_bytes, announced_bytes / 12, limit));
+    }
+  }
+
   // The client half-closed, or the call broke: a complete upload runs on the reserved slot; a
   // broken one (the client cancelled, its deadline passed, the connection dropped) is CANCELLED or
   // DEADLINE_EXCEEDED, and a half-closed incomplete one is INVALID_ARGUMENT, without a worker.

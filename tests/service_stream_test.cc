@@ -178,6 +178,34 @@ TEST_F(ServiceStream, HeaderValidationNamesTheField) {
   EXPECT_THAT(streamed.status.error_message(), HasSubstr("header.request.options.profile"));
 }
 
+TEST(ServiceStreamLimits, TooManyPointsAreRefusedAtTheHeaderWithTheUnaryCode) {
+  server::ServerConfig config = TestConfig(1, 1);
+  config.planning.max_cloud_points = 1000;  // the three-tube cloud has ~31 k points
+  TestServer server(config);
+  auto header_only = StreamMessages(ThreeTubeCloud(), kChunk);
+  header_only.resize(1);  // no chunk is needed for the answer
+  grpc::ClientContext context;
+  SetTimeout(&context, std::chrono::seconds(30));
+  v1::PlanPickStreamResponse response;
+  std::unique_ptr<grpc::ClientWriter<v1::PlanPickStreamRequest>> writer =
+      server.stub().PlanPickStream(&context, &response);
+  writer->Write(header_only[0]);
+  writer->WritesDone();
+  const grpc::Status streamed = writer->Finish();
+  EXPECT_EQ(streamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(streamed.error_message(),
+              HasSubstr(std::to_string(ThreeTubeCloud().size() / 12) +
+                        " points, more than the limit of 1000 (planning.max_cloud_points)"));
+
+  grpc::ClientContext unary_context;
+  SetTimeout(&unary_context, std::chrono::seconds(30));
+  v1::PlanPickResponse unary_response;
+  const grpc::Status unary =
+      server.stub().PlanPick(&unary_context, PlanRequest(ThreeTubeCloud()), &unary_response);
+  EXPECT_EQ(unary.error_code(), streamed.error_code());
+  EXPECT_THAT(unary.error_message(), HasSubstr("(planning.max_cloud_points)"));
+}
+
 // Waits until the server counts `n` uploads in progress (the tubepick_stream_uploads gauge).
 void WaitForUploads(const TestServer& server, double n) {
   const auto reached = WaitFor(

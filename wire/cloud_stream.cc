@@ -95,8 +95,7 @@ void CloudStreamAssembler::Add(const v1::PlanPickStreamRequest& message) {
             "in chunks), got " +
             std::to_string(header.request().cloud().xyz().size()) + " bytes");
       }
-      header_ = header;
-      joined_.reserve(total);
+      header_ = header;  // the cloud's memory is reserved with the first chunk, after admission
       return;
     }
     case v1::PlanPickStreamRequest::kChunk: {
@@ -116,6 +115,7 @@ void CloudStreamAssembler::Add(const v1::PlanPickStreamRequest& message) {
                               " bytes exceed header.total_bytes " + std::to_string(header_->total_bytes()) +
                               " (" + std::to_string(received_bytes_) + " bytes received before it)");
       }
+      if (received_bytes_ == 0) joined_.reserve(header_->total_bytes());
       received_bytes_ += size;
       if (index != next_index_) {
         chunks_.emplace(index, chunk.data());

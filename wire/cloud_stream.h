@@ -32,8 +32,10 @@ class CloudStreamAssembler {
   /// `max_total_bytes`: largest total_bytes a header may announce (ServerConfig::max_stream_bytes).
   explicit CloudStreamAssembler(std::uint64_t max_total_bytes);
 
-  /// Feeds one stream message. @throws InvalidArgument (a second header, a chunk before the header,
-  /// a chunk index ≥ chunk_count, a duplicate, more bytes than announced, an empty message).
+  /// Feeds one stream message. The header reserves no memory: the cloud's buffer is reserved with the
+  /// first chunk, so a server can admit (or refuse) the call between the two. @throws InvalidArgument (a
+  /// second header, a chunk before the header, a chunk index ≥ chunk_count, a duplicate, more bytes than
+  /// announced, an empty message).
   void Add(const v1::PlanPickStreamRequest& message);
   bool has_header() const { return header_.has_value(); }
   /// The header's request (valid after the header arrived).
