@@ -45,6 +45,14 @@ std::string JoinNames(const std::map<std::string, Params>& profiles) {
   return names;
 }
 
+// @throws InvalidArgument when planning.profile names none of the profiles.
+void RequireKnownProfile(const PlanningDefaults& p) {
+  if (!p.profiles.count(p.profile)) {
+    throw InvalidArgument("planning.profile: unknown profile '" + p.profile +
+                          "' (known: " + JoinNames(p.profiles) + ")");
+  }
+}
+
 // Rewrites an error of the cell schema (paths relative to the cell document) into the server
 // config's key paths: "tube.radius: ..." → "cell.tube.radius: ...",
 // "unknown key(s): tube.colour" → "unknown key(s): cell.tube.colour".
@@ -193,10 +201,7 @@ void ResolveTlsPaths(TlsConfig& tls, const std::string& base_dir) {
 
 // Replaces the default profile's params with `params_file` read over them.
 void ApplyParamsFile(const std::string& params_file, const std::string& base_dir, PlanningDefaults& p) {
-  if (!p.profiles.count(p.profile)) {
-    throw InvalidArgument("planning.profile: unknown profile '" + p.profile +
-                          "' (known: " + JoinNames(p.profiles) + ")");
-  }
+  RequireKnownProfile(p);
   if (params_file.empty()) return;
   const std::string path = ResolvePath(params_file, base_dir);
   try {
@@ -315,10 +320,7 @@ void ServerConfig::Validate() const {
       throw InvalidArgument("planning.profiles: the shipped profile '" + name + "' is missing");
     }
   }
-  if (!planning.profiles.count(planning.profile)) {
-    throw InvalidArgument("planning.profile: unknown profile '" + planning.profile +
-                          "' (known: " + JoinNames(planning.profiles) + ")");
-  }
+  RequireKnownProfile(planning);
   for (const auto& [name, params] : planning.profiles) {
     try {
       params.Validate();
