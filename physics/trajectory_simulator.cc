@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/common/errors.h"
+#include "core/common/thread_budget.h"
 
 namespace tubepick::physics {
 namespace {
@@ -293,8 +294,7 @@ std::vector<TrajectoryOutcome> BulletTrajectoryEvaluator::Evaluate(
 
   const std::size_t count = trajectories.size();
   std::vector<TrajectoryOutcome> outcomes(count);
-  std::size_t threads = params_.threads > 0 ? static_cast<std::size_t>(params_.threads)
-                                            : std::max(1u, std::thread::hardware_concurrency());
+  std::size_t threads = static_cast<std::size_t>(ResolveThreads(static_cast<std::uint32_t>(params_.threads)));
   threads = std::min(threads, count);
   if (threads == 1) {
     for (std::size_t k = 0; k < count; ++k)

@@ -83,7 +83,8 @@ struct TrajectorySimParams {
   /// the real 1 cm so that a tube end modeled slightly into a wall is pushed back out rather than
   /// through it (or down through the floor).
   double wall_thickness = 0.05;
-  /// Worker threads that simulate trajectories in parallel; 0 = hardware concurrency.
+  /// Worker threads that simulate trajectories in parallel; 0 = the cores the process may use
+  /// (CoresAvailable).
   int threads = 0;
   /// The bin the tubes lie in (its floor and walls are bodies of every world).
   BinConfig bin;

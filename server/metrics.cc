@@ -85,7 +85,7 @@ std::uint64_t Metrics::rejected() const {
   return rejected_;
 }
 
-std::string Metrics::RenderPrometheus(const PoolLoad& load) const {
+std::string Metrics::RenderPrometheus(const PoolLoad& load, std::uint32_t uploads) const {
   std::string out;
   auto o = std::back_inserter(out);
   auto header = [&](std::string_view name, std::string_view type, std::string_view help) {
@@ -119,8 +119,8 @@ std::string Metrics::RenderPrometheus(const PoolLoad& load) const {
   }
   header("tubepick_queue_depth", "gauge", "Admitted requests waiting for a planning worker.");
   fmt::format_to(o, "tubepick_queue_depth {}\n", load.queued);
-  header("tubepick_stream_uploads", "gauge", "Admitted PlanPickStream calls still receiving chunks.");
-  fmt::format_to(o, "tubepick_stream_uploads {}\n", load.reserved);
+  header("tubepick_stream_uploads", "gauge", "PlanPickStream calls still receiving their cloud.");
+  fmt::format_to(o, "tubepick_stream_uploads {}\n", uploads);
   header("tubepick_workers_busy", "gauge", "Planning workers running a request.");
   fmt::format_to(o, "tubepick_workers_busy {}\n", load.busy);
   header("tubepick_workers", "gauge", "Planning worker threads.");

@@ -45,8 +45,9 @@ class Metrics {
   std::uint64_t calls(std::string_view method, std::string_view code) const;
   std::uint64_t rejected() const;
 
-  /// Every metric with HELP and TYPE lines; `load` gives the queue and worker gauges.
-  std::string RenderPrometheus(const PoolLoad& load) const;
+  /// Every metric with HELP and TYPE lines; `load` gives the queue and worker gauges, `uploads`
+  /// the PlanPickStream uploads in progress.
+  std::string RenderPrometheus(const PoolLoad& load, std::uint32_t uploads) const;
 
  private:
   struct Histogram {

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <climits>
+#include <cmath>
 #include <condition_variable>
 #include <fstream>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/common/thread_budget.h"
 #include "grpc/health/v1/health.pb.h"
 #include "server/metrics.h"
 #include "server/metrics_http.h"
@@ -61,11 +63,6 @@ std::shared_ptr<grpc::ServerCredentials> MakeCredentials(const TlsConfig& tls) {
   return grpc::SslServerCredentials(options);
 }
 
-std::uint32_t WorkerCount(const ServerConfig& config) {
-  if (config.workers > 0) return config.workers;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
 // "::" → "[::]", so that "HOST:PORT" stays parseable.
 std::string HostForLog(const std::string& host) {
   return host.find(':') == std::string::npos ? host : "[" + host + "]";
@@ -73,6 +70,30 @@ std::string HostForLog(const std::string& host) {
 
 int ClampToInt(std::uint64_t v) {
   return v > static_cast<std::uint64_t>(INT_MAX) ? INT_MAX : static_cast<int>(v);
+}
+
+int Milliseconds(double seconds) {
+  return ClampToInt(static_cast<std::uint64_t>(std::llround(seconds * 1000.0)));
+}
+
+// Message sizes, gRPC's buffer memory and the HTTP/2 connection limits of server.connection.
+void ApplyLimits(const ServerConfig& config, grpc::ServerBuilder& builder) {
+  builder.SetMaxReceiveMessageSize(ClampToInt(config.max_message_bytes));
+  builder.SetMaxSendMessageSize(ClampToInt(config.max_message_bytes));
+  grpc::ResourceQuota quota("tubepick-server");
+  quota.Resize(static_cast<std::size_t>(config.resource_quota_bytes));
+  builder.SetResourceQuota(quota);
+  const ConnectionLimits& c = config.connection;
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, Milliseconds(c.keepalive_time));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, Milliseconds(c.keepalive_timeout));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
+                             Milliseconds(c.min_client_ping_interval));
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, 2);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, Milliseconds(c.max_idle));
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, Milliseconds(c.max_age));
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS, Milliseconds(c.max_age_grace));
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, ClampToInt(c.max_concurrent_streams));
 }
 
 }  // namespace
@@ -126,8 +147,7 @@ void PlannerServer::Start() {
   grpc::ServerBuilder builder;
   if (!config.reflection) builder.SetOption(std::make_unique<WithoutReflection>());
   builder.AddListeningPort(config.address, MakeCredentials(config.tls), &m.port);
-  builder.SetMaxReceiveMessageSize(ClampToInt(config.max_message_bytes));
-  builder.SetMaxSendMessageSize(ClampToInt(config.max_message_bytes));
+  ApplyLimits(config, builder);
   // A second server on a fixed, busy port must fail rather than share it silently.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.RegisterService(m.service.get());
@@ -143,8 +163,9 @@ void PlannerServer::Start() {
 
   if (!config.metrics_address.empty()) {
     try {
-      m.http = std::make_unique<MetricsHttpServer>(
-          config.metrics_address, [&m] { return m.metrics->RenderPrometheus(m.pool->load()); });
+      m.http = std::make_unique<MetricsHttpServer>(config.metrics_address, [&m] {
+        return m.metrics->RenderPrometheus(m.pool->load(), m.service->uploads_in_progress());
+      });
     } catch (...) {
       m.server->Shutdown(std::chrono::system_clock::now());
       m.server.reset();
@@ -157,9 +178,19 @@ void PlannerServer::Start() {
     m.state = Impl::State::kRunning;
   }
   const std::string host = HostForLog(SplitHostPort(config.address, "address").first);
-  spdlog::info("listening on {}:{} ({}, {} workers, queue {}, max message {} bytes)", host, m.port,
-               config.tls.enabled() ? (config.tls.require_client_cert ? "mutual TLS" : "TLS") : "plaintext",
-               m.pool->workers(), config.queue_capacity, config.max_message_bytes);
+  spdlog::info(
+      "listening on {}:{} ({}, {} workers x {} threads per call on {} cores, queue {}, uploads {}, "
+      "max message {} bytes)",
+      host, m.port,
+      config.tls.enabled() ? (config.tls.require_client_cert ? "mutual TLS" : "TLS") : "plaintext",
+      m.pool->workers(), ThreadsPerCall(config), CoresAvailable(), config.queue_capacity, config.max_uploads,
+      config.max_message_bytes);
+  if (m.pool->workers() * ThreadsPerCall(config) > static_cast<std::uint32_t>(CoresAvailable())) {
+    spdlog::warn(
+        "{} workers x {} threads per call exceed the {} cores this process may use: calls will "
+        "share cores (server.workers, server.threads_per_call)",
+        m.pool->workers(), ThreadsPerCall(config), CoresAvailable());
+  }
   if (m.http) {
     spdlog::info("metrics on http://{}:{}/metrics",
                  HostForLog(SplitHostPort(config.metrics_address, "metrics_address").first), m.http->port());

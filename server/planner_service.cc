@@ -60,12 +60,18 @@ std::optional<Clock::time_point> SteadyDeadline(const grpc::CallbackServerContex
 
 /// Bookkeeping shared by the unary and the stream reactors.
 struct PlannerService::CallState {
-  CallState(grpc::CallbackServerContext* context, const char* rpc) : arrived(Clock::now()) {
+  CallState(grpc::CallbackServerContext* context, const char* rpc, double max_call_time)
+      : arrived(Clock::now()) {
     record.rpc = rpc;
     record.request_id = RequestIdOf(*context);
     record.peer = context->peer();
     deadline = SteadyDeadline(*context);
-    if (deadline) token.set_deadline(*deadline);
+    if (!deadline) {  // no call runs forever: server.max_call_time is the deadline of one that sets none
+      deadline =
+          arrived + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(max_call_time));
+      max_call_time_s = max_call_time;
+    }
+    token.set_deadline(*deadline);
     context->AddInitialMetadata("x-request-id", record.request_id);
   }
 
@@ -88,12 +94,18 @@ struct PlannerService::CallState {
   grpc::Status CancelledStatus(const std::string& what) const {
     if (!token.deadline_passed()) return {grpc::StatusCode::CANCELLED, what};
     const std::string_view cancelled = "cancelled ";
-    return {grpc::StatusCode::DEADLINE_EXCEEDED,
-            what.rfind(cancelled, 0) == 0 ? "deadline exceeded " + what.substr(cancelled.size()) : what};
+    std::string message =
+        what.rfind(cancelled, 0) == 0 ? "deadline exceeded " + what.substr(cancelled.size()) : what;
+    if (max_call_time_s) {
+      message += fmt::format(" (the call set no deadline; server.max_call_time is {:g} s)", *max_call_time_s);
+    }
+    return {grpc::StatusCode::DEADLINE_EXCEEDED, message};
   }
 
   const Clock::time_point arrived;
   std::optional<Clock::time_point> deadline;
+  /// Set when the deadline is server.max_call_time's, not the client's.
+  std::optional<double> max_call_time_s;
   StopToken token;
   std::atomic<std::int64_t> cancelled_at{0};  // steady ns of OnCancel; 0 = not cancelled
   bool ran = false;                           // reached a worker and started
@@ -103,7 +115,7 @@ struct PlannerService::CallState {
 class PlannerService::UnaryCall final : public grpc::ServerUnaryReactor {
  public:
   UnaryCall(PlannerService* service, grpc::CallbackServerContext* context, const char* rpc)
-      : service_(service), state_(context, rpc) {
+      : service_(service), state_(context, rpc, service->config_.max_call_time) {
     service_->Register(&state_.token);
   }
   CallState& state() { return state_; }
@@ -121,15 +133,20 @@ class PlannerService::UnaryCall final : public grpc::ServerUnaryReactor {
   CallState state_;
 };
 
+/// One PlanPickStream: the upload (admitted by UploadSlots, watched for silence by the
+/// UploadWatchdog), then the planning job on the WorkerPool. Who finishes the call is settled by its
+/// UploadWatch: the reactor, or the watchdog when the upload went quiet (then the reactor neither
+/// reads on nor finishes).
 class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::PlanPickStreamRequest> {
  public:
   StreamCall(PlannerService* service, grpc::CallbackServerContext* context,
              v1::PlanPickStreamResponse* response)
       : service_(service),
         context_(context),
-        state_(context, "PlanPickStream"),
+        state_(context, "PlanPickStream", service->config_.max_call_time),
         response_(response),
-        assembler_(service->config_.max_stream_bytes) {
+        assembler_(service->config_.max_stream_bytes),
+        watch_(service->upload_watchdog_.Watch([this] { FinishIdle(); })) {
     service_->Register(&state_.token);
     StartRead(&message_);
   }
@@ -139,6 +156,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
       UploadEnded();
       return;
     }
+    if (!watch_->Touch()) return;  // the watchdog ended the upload
     try {
       const bool had_header = assembler_.has_header();
       const std::uint64_t announced = message_.has_header() ? message_.header().total_bytes() : 0;
@@ -146,13 +164,14 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
       if (!had_header) {  // Add accepts nothing but a header first
         state_.record.points = announced / 12;
         RequireAnnouncedPointsWithinLimit(announced);
-        std::optional<WorkerPool::Reservation> slot = service_->pool_->TryReserve();
-        if (!slot) {
-          Answer(service_->Rejected(state_));
+        if (std::optional<grpc::Status> refused = AdmitUpload()) {
+          Answer(*refused);
           return;
         }
-        reservation_ = std::move(*slot);
       }
+    } catch (const TooLarge& e) {
+      Answer(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what()));
+      return;
     } catch (const InvalidArgument& e) {
       Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what()));
       return;
@@ -173,17 +192,36 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   void RequireAnnouncedPointsWithinLimit(std::uint64_t announced_bytes) const {
     const std::uint64_t limit = service_->config_.planning.max_cloud_points;
     if (announced_bytes / 12 > limit) {
-      throw InvalidArgument(
+      throw TooLarge(
           fmt::format("header.total_bytes: {} bytes announce {} points, more than the limit of {} "
                       "(planning.max_cloud_points)",
                       announced_bytes, announced_bytes / 12, limit));
     }
   }
 
-  // The client half-closed, or the call broke: a complete upload runs on the reserved slot; a
+  // At the header: refused at once when planning is full (the cloud could not run when complete)
+  // or when server.max_uploads uploads are in progress; else the upload takes its slot.
+  std::optional<grpc::Status> AdmitUpload() {
+    if (!service_->pool_->HasRoom()) return service_->Rejected(state_);
+    std::optional<UploadSlots::Slot> slot = service_->uploads_.TryAcquire();
+    if (!slot) {
+      service_->metrics_->RecordRejected();
+      return grpc::Status(
+          grpc::StatusCode::RESOURCE_EXHAUSTED,
+          fmt::format("uploads full: {} PlanPickStream uploads in progress (server.max_uploads); "
+                      "retry later",
+                      service_->uploads_.capacity()));
+    }
+    upload_slot_ = std::move(*slot);
+    return std::nullopt;
+  }
+
+  // The client half-closed, or the call broke: a complete upload asks the pool for a worker; a
   // broken one (the client cancelled, its deadline passed, the connection dropped) is CANCELLED or
   // DEADLINE_EXCEEDED, and a half-closed incomplete one is INVALID_ARGUMENT, without a worker.
   void UploadEnded() {
+    if (!watch_->StopWatching()) return;  // the watchdog ended the upload
+    upload_slot_.Release();
     if (state_.token.should_stop() || context_->IsCancelled()) {
       state_.MarkCancelled();
       Answer(state_.CancelledStatus(fmt::format("stopped while the cloud was uploading ({} bytes received)",
@@ -202,26 +240,44 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
       return;
     }
     const Clock::time_point enqueued = Clock::now();
-    const WorkerPool::Admission admission =
-        service_->pool_->Submit(std::move(reservation_), [this, enqueued] {
-          const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
-            PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
-            std::string().swap(cloud_);  // the decoded points are all that is needed now
-            state_.record.points = job.points_Sensor.size();
-            *response_->mutable_response() =
-                RunPlanPick(job, service_->config_.planning,
-                            static_cast<int>(service_->config_.planning.simulation_threads), &state_.token);
-            state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
-            state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
-          });
-          Answer(status);
-        });
-    if (admission != WorkerPool::Admission::kAdmitted)
+    const WorkerPool::Admission admission = service_->pool_->TrySubmit([this, enqueued] {
+      const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
+        PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
+        std::string().swap(cloud_);  // the decoded points are all that is needed now
+        state_.record.points = job.points_Sensor.size();
+        *response_->mutable_response() =
+            RunPlanPick(job, service_->config_.planning, service_->threads_per_call_, &state_.token);
+        state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
+        state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
+      });
+      Answer(status);
+    });
+    if (admission == WorkerPool::Admission::kFull) {
+      Answer(service_->Rejected(state_));
+    } else if (admission == WorkerPool::Admission::kStopped) {
       Answer(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
+    }
+  }
+
+  // On the watchdog's thread, which took the call over: nothing arrived for stream_idle_timeout.
+  void FinishIdle() {
+    upload_slot_.Release();
+    const double timeout = service_->config_.stream_idle_timeout;
+    const std::string progress =
+        assembler_.has_header()
+            ? fmt::format("{} of {} bytes received", assembler_.received_bytes(), state_.record.points * 12)
+            : std::string("before its header");
+    Finish(service_->Conclude(
+        state_,
+        grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED,
+                     fmt::format("upload idle: no message for {:g} s (server.stream_idle_timeout), {}; "
+                                 "the upload is ended",
+                                 timeout, progress))));
   }
 
   void Answer(grpc::Status status) {
-    reservation_.Release();
+    if (!watch_->ClaimFinish()) return;  // the watchdog finishes this call
+    upload_slot_.Release();
     Finish(service_->Conclude(state_, std::move(status)));
   }
 
@@ -233,11 +289,18 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   CloudStreamAssembler assembler_;
   /// The joined cloud bytes of a complete upload, until the job has decoded them.
   std::string cloud_;
-  WorkerPool::Reservation reservation_;
+  UploadSlots::Slot upload_slot_;
+  std::shared_ptr<UploadWatch> watch_;
 };
 
 PlannerService::PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics)
-    : config_(std::move(config)), pool_(pool), metrics_(metrics) {}
+    : config_(std::move(config)),
+      threads_per_call_(ThreadsPerCall(config_)),
+      pool_(pool),
+      metrics_(metrics),
+      uploads_(config_.max_uploads),
+      upload_watchdog_(std::chrono::duration_cast<Clock::duration>(
+          std::chrono::duration<double>(config_.stream_idle_timeout))) {}
 
 void PlannerService::Register(StopToken* token) {
   std::lock_guard lock(calls_mu_);
@@ -263,8 +326,7 @@ grpc::Status PlannerService::Rejected(const CallState&) {
   metrics_->RecordRejected();
   const PoolLoad load = pool_->load();
   return {grpc::StatusCode::RESOURCE_EXHAUSTED,
-          fmt::format("planning queue full: {} running, {} queued; retry later", load.busy,
-                      load.queued + load.reserved)};
+          fmt::format("planning queue full: {} running, {} queued; retry later", load.busy, load.queued)};
 }
 
 grpc::Status PlannerService::Conclude(CallState& call, grpc::Status status) {
@@ -301,6 +363,8 @@ grpc::Status PlannerService::RunOnWorker(CallState& call, Clock::time_point enqu
     body();
   } catch (const Cancelled& e) {
     status = call.CancelledStatus(e.what());
+  } catch (const TooLarge& e) {
+    status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what());
   } catch (const InvalidArgument& e) {
     status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
   } catch (const FailedPrecondition& e) {
@@ -343,7 +407,7 @@ grpc::ServerUnaryReactor* PlannerService::ModelTubes(grpc::CallbackServerContext
   return StartPlanning(context, "ModelTubes", request->cloud().xyz().size() / 12,
                        [this, request, response](CallState& call) {
                          const PlanningJob job = ValidateModelTubes(*request, config_.planning);
-                         *response = RunModelTubes(job, &call.token);
+                         *response = RunModelTubes(job, threads_per_call_, &call.token);
                          call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
                        });
 }
@@ -351,14 +415,13 @@ grpc::ServerUnaryReactor* PlannerService::ModelTubes(grpc::CallbackServerContext
 grpc::ServerUnaryReactor* PlannerService::PlanPick(grpc::CallbackServerContext* context,
                                                    const v1::PlanPickRequest* request,
                                                    v1::PlanPickResponse* response) {
-  return StartPlanning(
-      context, "PlanPick", request->cloud().xyz().size() / 12, [this, request, response](CallState& call) {
-        const PlanningJob job = ValidatePlanPick(*request, config_.planning);
-        *response = RunPlanPick(job, config_.planning, static_cast<int>(config_.planning.simulation_threads),
-                                &call.token);
-        call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
-        call.record.plans = static_cast<std::uint32_t>(response->plans_size());
-      });
+  return StartPlanning(context, "PlanPick", request->cloud().xyz().size() / 12,
+                       [this, request, response](CallState& call) {
+                         const PlanningJob job = ValidatePlanPick(*request, config_.planning);
+                         *response = RunPlanPick(job, config_.planning, threads_per_call_, &call.token);
+                         call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
+                         call.record.plans = static_cast<std::uint32_t>(response->plans_size());
+                       });
 }
 
 grpc::ServerReadReactor<v1::PlanPickStreamRequest>* PlannerService::PlanPickStream(

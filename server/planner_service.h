@@ -10,6 +10,8 @@
 #include "core/common/stop_token.h"
 #include "server/metrics.h"
 #include "server/server_config.h"
+#include "server/upload_slots.h"
+#include "server/upload_watchdog.h"
 #include "server/worker_pool.h"
 #include "tubepick/v1/service.grpc.pb.h"
 
@@ -20,14 +22,19 @@ namespace tubepick::server {
 ///   one), echoed in the initial metadata and written in its log line (LogCall) and metrics;
 /// - gets a StopToken carrying the call's deadline, stopped by ServerUnaryReactor::OnCancel
 ///   (client cancel, deadline, shutdown), which modeling and simulation poll;
-/// - ModelTubes / PlanPick / PlanPickStream are admitted to the WorkerPool or refused at once with
-///   RESOURCE_EXHAUSTED; a PlanPickStream takes its slot when its header arrives (so uploads in
-///   progress count against admission and memory) and gives it back when it fails. Validation and
-///   work run on the worker; a call whose deadline passed (or that was cancelled) while queued is
-///   dropped without running. AnalyzeWrench is microseconds of arithmetic and runs inline;
-/// - errors map as: InvalidArgument → INVALID_ARGUMENT (its message), FailedPrecondition (a cloud
-///   that misses the bin) → FAILED_PRECONDITION (its message), Cancelled → CANCELLED or
-///   DEADLINE_EXCEEDED, anything else → INTERNAL (logged with the request id).
+/// - a call without a deadline gets server.max_call_time as its deadline;
+/// - ModelTubes / PlanPick are admitted to the WorkerPool or refused at once with
+///   RESOURCE_EXHAUSTED. A PlanPickStream's upload is admitted apart (UploadSlots,
+///   server.max_uploads: an upload holds no planning slot), is ended by the UploadWatchdog after
+///   server.stream_idle_timeout without a message, and its complete cloud then asks the WorkerPool
+///   for a slot like a unary call. Validation and work run on the worker with ThreadsPerCall
+///   threads; a call whose deadline passed (or that was cancelled) while queued is dropped without
+///   running. AnalyzeWrench is microseconds of arithmetic and runs inline;
+/// - errors map as: TooLarge (over a point or byte limit) → RESOURCE_EXHAUSTED, the code gRPC gives
+///   a message over max_message_bytes; InvalidArgument → INVALID_ARGUMENT (its message);
+///   FailedPrecondition (a cloud that misses the bin) → FAILED_PRECONDITION (its message);
+///   Cancelled → CANCELLED or DEADLINE_EXCEEDED; anything else → INTERNAL (logged with the
+///   request id).
 class PlannerService final : public v1::PickPlannerService::CallbackService {
  public:
   /// `pool` and `metrics` must outlive the service.
@@ -51,6 +58,8 @@ class PlannerService final : public v1::PickPlannerService::CallbackService {
   std::size_t calls_in_flight() const;
   /// Calls answered so far, any status.
   std::uint64_t calls_served() const { return served_.load(); }
+  /// PlanPickStream calls still receiving their cloud.
+  std::uint32_t uploads_in_progress() const { return uploads_.in_use(); }
 
  private:
   struct CallState;
@@ -69,8 +78,11 @@ class PlannerService final : public v1::PickPlannerService::CallbackService {
   void Unregister(StopToken* token);
 
   const ServerConfig config_;
+  const std::uint32_t threads_per_call_;
   WorkerPool* pool_;
   Metrics* metrics_;
+  UploadSlots uploads_;
+  UploadWatchdog upload_watchdog_;
   mutable std::mutex calls_mu_;
   std::set<StopToken*> active_;
   std::atomic<std::uint64_t> served_{0};

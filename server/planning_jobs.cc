@@ -14,7 +14,7 @@
 namespace tubepick::server {
 namespace {
 
-ModelingResult Model(const PlanningJob& job, const StopToken* stop) {
+ModelingResult Model(const PlanningJob& job, std::uint32_t threads, const StopToken* stop) {
   ThrowIfStopped(stop, "request admission");
   ModelingInput input;
   input.points_Sensor = &job.points_Sensor;
@@ -22,23 +22,25 @@ ModelingResult Model(const PlanningJob& job, const StopToken* stop) {
   input.X_BinSensor = job.cell.sensor.X_BinSensor;
   input.bin = job.cell.bin;
   input.seed = job.seed;
-  return ModelTubes(input, job.params.modeling, stop);
+  ModelingParams params = job.params.modeling;
+  params.threads = threads;
+  return ModelTubes(input, params, stop);
 }
 
 }  // namespace
 
-v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, const StopToken* stop) {
-  return ToModelTubesResponse(Model(job, stop), job.profile, job.seed);
+v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, std::uint32_t threads, const StopToken* stop) {
+  return ToModelTubesResponse(Model(job, threads, stop), job.profile, job.seed);
 }
 
 v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults& defaults,
-                                 int simulation_threads, const StopToken* stop) {
-  const ModelingResult modeling = Model(job, stop);
+                                 std::uint32_t threads, const StopToken* stop) {
+  const ModelingResult modeling = Model(job, threads, stop);
 
   std::unique_ptr<physics::BulletTrajectoryEvaluator> evaluator;
   if (!job.disable_simulation) {
     evaluator = std::make_unique<physics::BulletTrajectoryEvaluator>(physics::SimParamsForCell(
-        defaults.simulation, job.cell, job.params.planning.cost.max_displacement, simulation_threads));
+        defaults.simulation, job.cell, job.params.planning.cost.max_displacement, static_cast<int>(threads)));
   }
   PickPlanResult plan = PlanPick(modeling, job.cell, job.params.planning, evaluator.get(), job.seed, stop);
   // Truncate first: placements are computed only for the plans that are sent.

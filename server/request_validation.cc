@@ -122,8 +122,8 @@ Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::st
   }
   const std::uint64_t count = xyz.size() / 12;
   if (count > max_points) {
-    throw InvalidArgument(field + ": " + std::to_string(count) + " points exceed the limit of " +
-                          std::to_string(max_points) + " (planning.max_cloud_points)");
+    throw TooLarge(field + ": " + std::to_string(count) + " points exceed the limit of " +
+                   std::to_string(max_points) + " (planning.max_cloud_points)");
   }
   return UnpackXyz(xyz);
 }

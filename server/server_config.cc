@@ -8,12 +8,27 @@
 #include <optional>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "core/common/cell_config_fields.h"
 #include "core/common/config_fields.h"
 #include "core/common/errors.h"
 #include "core/common/require.h"
+#include "core/common/thread_budget.h"
 
 namespace tubepick::server {
+
+template <typename Visit>
+void DescribeFields(Visit& v, ConnectionLimits& c) {
+  v("keepalive_time", c.keepalive_time, "Ping a connection after this long without activity, s.");
+  v("keepalive_timeout", c.keepalive_timeout, "Close it when the ping is not answered within, s.");
+  v("min_client_ping_interval", c.min_client_ping_interval,
+    "Clients may ping this often (also without calls); faster = GOAWAY too_many_pings, s.");
+  v("max_idle", c.max_idle, "Close a connection without calls after this long (GOAWAY), s.");
+  v("max_age", c.max_age, "Close every connection after this long so clients rebalance, s;");
+  v("max_age_grace", c.max_age_grace, "calls in flight then get this long to finish, s.");
+  v("max_concurrent_streams", c.max_concurrent_streams, "Calls in flight at once on one connection.");
+}
 
 // The `server.tls` section (in the namespace of TlsConfig, where the config visitors look for it).
 template <typename Visit>
@@ -113,13 +128,24 @@ void DescribeFields(Visit& v, ServerSection& section) {
   v("address", c.address,
     "gRPC listen address, HOST:PORT (port 0 = any, IPv6 \"[::]:50051\"); \"0.0.0.0:50051\" = all "
     "interfaces.");
-  v("workers", c.workers, "Planning worker threads; 0 = one per hardware thread.");
+  v("workers", c.workers, "Planning worker threads; 0 = the cores the process may use (affinity, cgroup).");
+  v("threads_per_call", c.threads_per_call,
+    "Threads one planning call runs on (modeling's OpenMP regions, the trajectory simulation),\n"
+    "whatever OMP_NUM_THREADS says; 0 = cores / workers, at least 1.");
   v("queue_capacity", c.queue_capacity,
     "Admitted calls that may wait for a free worker; more are answered RESOURCE_EXHAUSTED. >= 1.");
   v("max_message_bytes", c.max_message_bytes,
     "Largest gRPC message received or sent, bytes, in [1 MiB, 2 GiB): 64 MiB.");
   v("max_stream_bytes", c.max_stream_bytes,
     "Largest cloud a PlanPickStream header may announce, bytes: 512 MiB.");
+  v("max_uploads", c.max_uploads,
+    "PlanPickStream uploads in progress at once; more are RESOURCE_EXHAUSTED. Uploads hold no\n"
+    "planning slot.");
+  v("stream_idle_timeout", c.stream_idle_timeout,
+    "An upload that sends nothing for this long ends with DEADLINE_EXCEEDED, seconds.");
+  v("max_call_time", c.max_call_time, "The deadline of a call that sets none, seconds.");
+  v("resource_quota_bytes", c.resource_quota_bytes,
+    "gRPC's buffer memory for all connections, bytes: 1 GiB.");
   v("shutdown_grace", c.shutdown_grace,
     "On SIGTERM, in-flight calls get this long to finish before they are cancelled, seconds.");
   v("metrics_address", c.metrics_address,
@@ -127,6 +153,7 @@ void DescribeFields(Visit& v, ServerSection& section) {
   v("reflection", c.reflection, "gRPC server reflection (buf curl, grpcurl); false publishes no schema.");
   v("log_level", c.log_level, "trace, debug, info, warn, error, critical or off.");
   v("log_format", c.log_format, "text, or json (one JSON object per line).");
+  v.Section("connection", c.connection, "HTTP/2 connection limits (keepalive, idle, age, streams).");
   v.Section("tls", c.tls);
 }
 
@@ -169,9 +196,6 @@ void DescribeFields(Visit& v, PlanningSection& section) {
     "A `tubepick params --dump` YAML (complete or partial) that replaces the parameters of the\n"
     "profile above; \"\" = the compiled-in profile.");
   v("max_cloud_points", p.max_cloud_points, "Largest cloud accepted, points (12 bytes each).");
-  v("simulation_threads", p.simulation_threads,
-    "Threads one PlanPick simulates its trajectories on; 0 = one per hardware thread. Calls already\n"
-    "run in parallel on the workers, so 1 keeps workers x threads at the core count.");
   SimulationSection simulation{p.simulation};
   v.Section("simulation", simulation,
             "Trajectory simulation (Bullet). The bin and the tube mass come from the request's cell, the\n"
@@ -244,6 +268,34 @@ bool ValidHost(const std::string& host) {
   return true;
 }
 
+void RequireCount(std::uint64_t value, std::uint64_t lo, std::uint64_t hi, const std::string& key) {
+  if (value < lo || value > hi) {
+    throw InvalidArgument(fmt::format("{}: {} is out of range [{}, {}]", key, value, lo, hi));
+  }
+}
+
+// The limits of threads, uploads, call time, gRPC memory and connections.
+void ValidateCallLimits(const ServerConfig& c) {
+  RequireCount(c.threads_per_call, 0, 1024, "server.threads_per_call");
+  RequireCount(c.max_uploads, 1, 100'000, "server.max_uploads");
+  RequireInRange(c.stream_idle_timeout, 0.01, 3600.0, "server.stream_idle_timeout");
+  RequireInRange(c.max_call_time, 0.01, 86400.0, "server.max_call_time");
+  if (c.resource_quota_bytes < c.max_message_bytes) {
+    throw InvalidArgument(fmt::format(
+        "server.resource_quota_bytes: {} is less than server.max_message_bytes ({}): a largest message must "
+        "fit in gRPC's buffer memory",
+        c.resource_quota_bytes, c.max_message_bytes));
+  }
+  const ConnectionLimits& k = c.connection;
+  RequireInRange(k.keepalive_time, 0.01, 86400.0, "server.connection.keepalive_time");
+  RequireInRange(k.keepalive_timeout, 0.01, 3600.0, "server.connection.keepalive_timeout");
+  RequireInRange(k.min_client_ping_interval, 0.0, 86400.0, "server.connection.min_client_ping_interval");
+  RequireInRange(k.max_idle, 0.01, 30.0 * 86400.0, "server.connection.max_idle");
+  RequireInRange(k.max_age, 0.01, 30.0 * 86400.0, "server.connection.max_age");
+  RequireInRange(k.max_age_grace, 0.0, 86400.0, "server.connection.max_age_grace");
+  RequireCount(k.max_concurrent_streams, 1, 1'000'000, "server.connection.max_concurrent_streams");
+}
+
 void RequireReadableFile(const std::string& path, const std::string& key) {
   std::ifstream in(path);
   if (!in) throw InvalidArgument(key + ": cannot read '" + path + "'");
@@ -255,6 +307,15 @@ std::map<std::string, Params> DefaultProfiles() {
   std::map<std::string, Params> profiles;
   for (const std::string& name : ProfileNames()) profiles.emplace(name, ProfileParams(name));
   return profiles;
+}
+
+std::uint32_t WorkerCount(const ServerConfig& config) {
+  return config.workers > 0 ? config.workers : static_cast<std::uint32_t>(CoresAvailable());
+}
+
+std::uint32_t ThreadsPerCall(const ServerConfig& config) {
+  if (config.threads_per_call > 0) return config.threads_per_call;
+  return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(CoresAvailable()) / WorkerCount(config));
 }
 
 void ValidateHostPort(const std::string& address, const std::string& key) {
@@ -289,6 +350,7 @@ void ServerConfig::Validate() const {
                           " is out of range [12, 1 TiB]");
   }
   RequireInRange(shutdown_grace, 0.0, 3600.0, "server.shutdown_grace");
+  ValidateCallLimits(*this);
   static const char* const kLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
   if (std::find(std::begin(kLevels), std::end(kLevels), log_level) == std::end(kLevels)) {
     throw InvalidArgument("server.log_level: unknown level '" + log_level +
@@ -329,10 +391,6 @@ void ServerConfig::Validate() const {
     }
   }
   if (planning.max_cloud_points < 1) throw InvalidArgument("planning.max_cloud_points: must be >= 1, got 0");
-  if (planning.simulation_threads > 1024) {
-    throw InvalidArgument("planning.simulation_threads: " + std::to_string(planning.simulation_threads) +
-                          " is out of range [0, 1024]");
-  }
   try {
     planning.simulation.Validate();
   } catch (const InvalidArgument& e) {

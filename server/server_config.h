@@ -39,13 +39,29 @@ struct PlanningDefaults {
   std::map<std::string, Params> profiles = DefaultProfiles();
   /// Largest cloud accepted, points (12 bytes each).
   std::uint64_t max_cloud_points = 10'000'000;
-  /// Threads each PlanPick simulates its trajectories on (RunPlanPick's `simulation_threads`);
-  /// 0 = hardware threads. Requests already run in parallel on the worker pool, so 1 keeps
-  /// workers × threads at the core count; raise it when few calls arrive at once and latency matters.
-  std::uint32_t simulation_threads = 1;
   /// Trajectory simulation (bin, tube mass and disp_max are filled per request from the cell and
-  /// the profile's planning.cost.max_displacement; `threads` is replaced by simulation_threads).
+  /// the profile's planning.cost.max_displacement; `threads` by the server's threads per call).
   physics::TrajectorySimParams simulation;
+};
+
+/// What a connection may do and how long it may live (gRPC channel arguments of the server).
+struct ConnectionLimits {
+  /// The server pings a connection after this long without activity, seconds (finds dead peers).
+  double keepalive_time = 30.0;
+  /// A ping not answered within this long closes the connection, seconds.
+  double keepalive_timeout = 10.0;
+  /// A client may ping at most this often (and may ping without calls in flight); faster pings
+  /// get a GOAWAY (too_many_pings), seconds.
+  double min_client_ping_interval = 10.0;
+  /// A connection without calls for this long is closed with a GOAWAY (clients reconnect), seconds.
+  double max_idle = 600.0;
+  /// Any connection is closed after this long so that clients rebalance, seconds; calls in flight
+  /// get max_age_grace more to finish.
+  double max_age = 3600.0;
+  double max_age_grace = 300.0;
+  /// Calls in flight at once on one connection (HTTP/2 SETTINGS_MAX_CONCURRENT_STREAMS); more wait
+  /// at the client.
+  std::uint32_t max_concurrent_streams = 32;
 };
 
 /// The whole server configuration (`tubepick-server --config FILE`; EmbeddedServerConfigYaml() is the
@@ -54,14 +70,29 @@ struct ServerConfig {
   /// gRPC listen address, HOST:PORT (port 0 = any free port). Loopback by default: a plant network
   /// is reached only when the deployment says so (the Docker image passes 0.0.0.0).
   std::string address = "127.0.0.1:50051";
-  /// Planning worker threads; 0 = hardware threads.
+  /// Planning worker threads; 0 = the cores the process may use (CoresAvailable: affinity, cgroup).
   std::uint32_t workers = 0;
+  /// Threads one planning call may run on: every parallel region of modeling (OpenMP) and the
+  /// trajectory simulation (Bullet worlds), whatever OMP_NUM_THREADS or a profile's
+  /// modeling.threads says. 0 = the cores the process may use ÷ workers, at least 1, so that
+  /// workers × threads_per_call stays within the cores.
+  std::uint32_t threads_per_call = 0;
   /// Admitted requests that may wait for a worker; beyond that RESOURCE_EXHAUSTED.
   std::uint32_t queue_capacity = 8;
   /// Largest gRPC message received or sent, bytes.
   std::uint64_t max_message_bytes = 64ull << 20;
   /// Largest cloud a PlanPickStream may announce, bytes.
   std::uint64_t max_stream_bytes = 512ull << 20;
+  /// PlanPickStream uploads in progress at once (header received, cloud incomplete); more are
+  /// answered RESOURCE_EXHAUSTED. Apart from planning admission: uploads never hold a worker slot.
+  std::uint32_t max_uploads = 16;
+  /// An upload that sends no message for this long is ended with DEADLINE_EXCEEDED, seconds.
+  double stream_idle_timeout = 10.0;
+  /// The deadline of a call that carries none, seconds: its work stops there with DEADLINE_EXCEEDED.
+  double max_call_time = 120.0;
+  /// gRPC's buffer memory for all connections (grpc::ResourceQuota), bytes; ≥ max_message_bytes.
+  std::uint64_t resource_quota_bytes = 1ull << 30;
+  ConnectionLimits connection;
   /// SIGTERM: in-flight calls get this long to finish, then are cancelled, seconds.
   double shutdown_grace = 10.0;
   /// Prometheus text metrics over HTTP at HOST:PORT/metrics; empty = off. Loopback by default.
@@ -79,6 +110,11 @@ struct ServerConfig {
   /// @throws InvalidArgument naming the first bad field and its value.
   void Validate() const;
 };
+
+/// Planning worker threads: `workers`, or CoresAvailable() for 0.
+std::uint32_t WorkerCount(const ServerConfig& config);
+/// Threads per planning call: `threads_per_call`, or CoresAvailable() ÷ WorkerCount() (≥ 1) for 0.
+std::uint32_t ThreadsPerCall(const ServerConfig& config);
 
 /// Checks a HOST:PORT address (host name, IPv4, or [IPv6]; port 0..65535).
 /// @throws InvalidArgument naming `key` and the address.

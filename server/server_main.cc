@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   app.add_option("--address", flags.address, "gRPC listen address HOST:PORT (port 0 = any free port)");
   app.add_option("--metrics-address", flags.metrics_address,
                  "Prometheus metrics HTTP address HOST:PORT; \"\" = off");
-  app.add_option("--workers", flags.workers, "Planning worker threads (0 = hardware threads)");
+  app.add_option("--workers", flags.workers, "Planning worker threads (0 = the cores the process may use)");
   app.add_option("--log-level", flags.log_level, "trace, debug, info, warn, error, critical, off");
   app.add_option("--log-format", flags.log_format, "text or json (one JSON object per line)");
   app.add_flag("--print-config", flags.print_config,

@@ -10,23 +10,6 @@
 
 namespace tubepick::server {
 
-WorkerPool::Reservation::Reservation(Reservation&& other) noexcept
-    : pool_(std::exchange(other.pool_, nullptr)) {}
-
-WorkerPool::Reservation& WorkerPool::Reservation::operator=(Reservation&& other) noexcept {
-  if (this != &other) {
-    Release();
-    pool_ = std::exchange(other.pool_, nullptr);
-  }
-  return *this;
-}
-
-WorkerPool::Reservation::~Reservation() { Release(); }
-
-void WorkerPool::Reservation::Release() {
-  if (pool_ != nullptr) std::exchange(pool_, nullptr)->ReleaseReservation();
-}
-
 WorkerPool::WorkerPool(std::uint32_t workers, std::uint32_t queue_capacity)
     : queue_capacity_(queue_capacity) {
   assert(workers >= 1);
@@ -37,7 +20,7 @@ WorkerPool::WorkerPool(std::uint32_t workers, std::uint32_t queue_capacity)
 WorkerPool::~WorkerPool() { Stop(); }
 
 bool WorkerPool::HasRoomLocked() const {
-  const std::size_t admitted = busy_ + queue_.size() + reserved_;
+  const std::size_t admitted = busy_ + queue_.size();
   return admitted < threads_.size() + queue_capacity_;
 }
 
@@ -52,30 +35,9 @@ WorkerPool::Admission WorkerPool::TrySubmit(Job job) {
   return Admission::kAdmitted;
 }
 
-std::optional<WorkerPool::Reservation> WorkerPool::TryReserve() {
+bool WorkerPool::HasRoom() const {
   std::lock_guard lock(mu_);
-  if (stopping_ || !HasRoomLocked()) return std::nullopt;
-  ++reserved_;
-  return Reservation(this);
-}
-
-WorkerPool::Admission WorkerPool::Submit(Reservation reservation, Job job) {
-  assert(reservation.pool_ == this);
-  {
-    std::lock_guard lock(mu_);
-    if (stopping_) return Admission::kStopped;  // ~Reservation releases the slot
-    reservation.pool_ = nullptr;                // the slot becomes the queued job
-    --reserved_;
-    queue_.push_back(std::move(job));
-  }
-  cv_.notify_one();
-  return Admission::kAdmitted;
-}
-
-void WorkerPool::ReleaseReservation() {
-  std::lock_guard lock(mu_);
-  assert(reserved_ > 0);
-  --reserved_;
+  return !stopping_ && HasRoomLocked();
 }
 
 PoolLoad WorkerPool::load() const {
@@ -84,7 +46,6 @@ PoolLoad WorkerPool::load() const {
   load.workers = static_cast<std::uint32_t>(threads_.size());
   load.busy = busy_;
   load.queued = static_cast<std::uint32_t>(queue_.size());
-  load.reserved = reserved_;
   return load;
 }
 

@@ -20,14 +20,11 @@ struct PoolLoad {
   std::uint32_t busy = 0;
   /// Jobs waiting for a worker.
   std::uint32_t queued = 0;
-  /// Admitted slots without a job yet (PlanPickStream uploads in progress).
-  std::uint32_t reserved = 0;
 };
 
 /// The bounded planning worker pool with admission control. At most `workers + queue_capacity`
-/// requests are admitted at a time (running, queued, or reserved by an upload in progress); beyond
-/// that TrySubmit / TryReserve say no at once, so the server answers RESOURCE_EXHAUSTED instead of
-/// letting memory grow. Jobs run in FIFO order. Thread-safe.
+/// jobs are admitted at a time (running or queued); beyond that TrySubmit says no at once, so the server
+/// answers RESOURCE_EXHAUSTED instead of letting memory grow. Jobs run in FIFO order. Thread-safe.
 class WorkerPool {
  public:
   /// A unit of work. Jobs report their own errors (PlannerService answers every call itself); one
@@ -41,33 +38,12 @@ class WorkerPool {
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  /// One admitted slot that holds no job yet (a stream whose chunks are still arriving). Counts
-  /// against admission until it is submitted or destroyed (destroying releases it). Movable.
-  class Reservation {
-   public:
-    Reservation() = default;
-    Reservation(Reservation&& other) noexcept;
-    Reservation& operator=(Reservation&& other) noexcept;
-    ~Reservation();
-    bool valid() const { return pool_ != nullptr; }
-    /// Gives the slot back without running anything.
-    void Release();
-
-   private:
-    friend class WorkerPool;
-    explicit Reservation(WorkerPool* pool) : pool_(pool) {}
-    WorkerPool* pool_ = nullptr;
-  };
-
   enum class Admission { kAdmitted, kFull, kStopped };
 
   /// Queues `job` when there is room; otherwise drops it and says why.
   Admission TrySubmit(Job job);
-  /// Takes a slot without a job; nullopt when full or stopped.
-  std::optional<Reservation> TryReserve();
-  /// Queues `job` on a reservation (never refused for lack of room). kStopped (job dropped) after
-  /// Stop(). The reservation is consumed either way.
-  Admission Submit(Reservation reservation, Job job);
+  /// Whether TrySubmit would admit a job now (a hint: another caller may take the room first).
+  bool HasRoom() const;
 
   PoolLoad load() const;
   std::uint32_t workers() const { return static_cast<std::uint32_t>(threads_.size()); }
@@ -82,14 +58,12 @@ class WorkerPool {
   void WorkerLoop();
   void RunGuarded(const Job& job);
   bool HasRoomLocked() const;
-  void ReleaseReservation();
 
   const std::uint32_t queue_capacity_;
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::deque<Job> queue_;
   std::uint32_t busy_ = 0;
-  std::uint32_t reserved_ = 0;
   bool stopping_ = false;
   std::atomic<std::uint64_t> escaped_exceptions_{0};
   std::mutex join_mu_;

@@ -72,6 +72,23 @@ TEST(ServiceDeadline, ATinyDeadlineIsExceededAndFreesTheWorker) {
             1.0);
 }
 
+// A call that sets no deadline gets server.max_call_time: a slow plan is stopped there with
+// DEADLINE_EXCEEDED that names the key, and the worker is free again.
+TEST(ServiceDeadline, ACallWithoutDeadlineStopsAtTheMaxCallTime) {
+  server::ServerConfig config = TestConfig(1, 1);
+  config.max_call_time = 0.5;
+  TestServer server(config);
+  grpc::ClientContext context;  // no deadline
+  v1::PlanPickResponse response;
+  const auto started = std::chrono::steady_clock::now();
+  const grpc::Status status = server.stub().PlanPick(&context, SlowPlanRequest(), &response);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("the call set no deadline; server.max_call_time is 0.5 s"));
+  EXPECT_GE(seconds, 0.5);
+  EXPECT_TRUE(WaitFor([&] { return server.server().workers_busy() == 0; }, std::chrono::seconds(10)));
+}
+
 TEST(ServiceDeadline, ClientCancelFreesTheWorkerAndExpiredQueuedCallsNeverRun) {
   TestServer server(TestConfig(1, 2));
   (void)BusyBinCloud();

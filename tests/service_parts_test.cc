@@ -12,11 +12,14 @@
 #include <future>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "core/common/errors.h"
 #include "server/metrics.h"
 #include "server/metrics_http.h"
 #include "server/request_log.h"
+#include "server/upload_slots.h"
+#include "server/upload_watchdog.h"
 #include "server/worker_pool.h"
 #include "tests/service_test_support.h"
 
@@ -41,29 +44,63 @@ TEST(WorkerPool, AdmitsWorkersPlusQueueThenRefuses) {
   ASSERT_EQ(pool.TrySubmit(blocking), WorkerPool::Admission::kAdmitted);
   ASSERT_TRUE(service_test::WaitFor([&] { return pool.load().busy == 1; }, std::chrono::seconds(5)));
   EXPECT_EQ(pool.TrySubmit(blocking), WorkerPool::Admission::kAdmitted);
-  std::optional<WorkerPool::Reservation> slot = pool.TryReserve();  // the third and last slot
-  ASSERT_TRUE(slot);
+  EXPECT_TRUE(pool.HasRoom());
+  EXPECT_EQ(pool.TrySubmit(blocking), WorkerPool::Admission::kAdmitted);  // the third and last slot
+  EXPECT_FALSE(pool.HasRoom());
   EXPECT_EQ(pool.TrySubmit(blocking), WorkerPool::Admission::kFull);
-  EXPECT_FALSE(pool.TryReserve());
-  PoolLoad load = pool.load();
+  const PoolLoad load = pool.load();
   EXPECT_EQ(load.workers, 1u);
   EXPECT_EQ(load.busy, 1u);
-  EXPECT_EQ(load.queued, 1u);
-  EXPECT_EQ(load.reserved, 1u);
-
-  slot->Release();  // an upload that failed gives its slot back
-  EXPECT_EQ(pool.load().reserved, 0u);
-  std::optional<WorkerPool::Reservation> again = pool.TryReserve();
-  ASSERT_TRUE(again);
-  EXPECT_EQ(pool.Submit(std::move(*again), blocking), WorkerPool::Admission::kAdmitted);
-  EXPECT_EQ(pool.load().queued, 2u);
-  EXPECT_EQ(pool.load().reserved, 0u);
+  EXPECT_EQ(load.queued, 2u);
 
   release.set_value();
   pool.Stop();  // runs what was queued, then joins
   EXPECT_EQ(ran.load(), 3);
   EXPECT_EQ(pool.TrySubmit(blocking), WorkerPool::Admission::kStopped);
-  EXPECT_FALSE(pool.TryReserve());
+  EXPECT_FALSE(pool.HasRoom());
+}
+
+// --- Upload admission and the idle watchdog --------------------------------------------------------
+
+TEST(UploadSlots, AdmitsCapacityThenRefusesAndSlotsComeBack) {
+  UploadSlots slots(2);
+  std::optional<UploadSlots::Slot> a = slots.TryAcquire();
+  std::optional<UploadSlots::Slot> b = slots.TryAcquire();
+  ASSERT_TRUE(a && b);
+  EXPECT_FALSE(slots.TryAcquire());
+  EXPECT_EQ(slots.in_use(), 2u);
+  a->Release();
+  EXPECT_EQ(slots.in_use(), 1u);
+  {
+    std::optional<UploadSlots::Slot> c = slots.TryAcquire();
+    ASSERT_TRUE(c);
+    UploadSlots::Slot moved = std::move(*c);  // moving does not release twice
+    EXPECT_EQ(slots.in_use(), 2u);
+  }
+  EXPECT_EQ(slots.in_use(), 1u);
+}
+
+TEST(UploadWatchdog, EndsAQuietUploadOnceAndLeavesActiveAndFinishedOnesAlone) {
+  UploadWatchdog watchdog(std::chrono::milliseconds(200));
+  std::atomic<int> quiet_ended{0}, active_ended{0}, done_ended{0};
+  std::shared_ptr<UploadWatch> quiet = watchdog.Watch([&] { ++quiet_ended; });
+  std::shared_ptr<UploadWatch> active = watchdog.Watch([&] { ++active_ended; });
+  std::shared_ptr<UploadWatch> done = watchdog.Watch([&] { ++done_ended; });
+  ASSERT_TRUE(done->StopWatching());  // complete upload: its job runs, however long
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(800);
+  while (std::chrono::steady_clock::now() < until) {
+    EXPECT_TRUE(active->Touch());
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(quiet_ended.load(), 1);
+  EXPECT_EQ(active_ended.load(), 0);
+  EXPECT_EQ(done_ended.load(), 0);
+  // The watchdog took the quiet call over: its reactor must neither read on nor finish it.
+  EXPECT_FALSE(quiet->Touch());
+  EXPECT_FALSE(quiet->ClaimFinish());
+  EXPECT_TRUE(active->ClaimFinish());
+  EXPECT_TRUE(done->ClaimFinish());
+  EXPECT_FALSE(done->ClaimFinish());
 }
 
 TEST(WorkerPool, AJobThatThrowsDoesNotTakeTheWorkerOrTheProcessDown) {
@@ -113,8 +150,7 @@ TEST(Metrics, HistogramBucketsAreCumulative) {
   load.workers = 4;
   load.busy = 2;
   load.queued = 3;
-  load.reserved = 1;
-  const std::string text = metrics.RenderPrometheus(load);
+  const std::string text = metrics.RenderPrometheus(load, 1);
   auto value = [&](const std::string& series) { return MetricValue(text, series); };
   EXPECT_EQ(value("tubepick_rpc_requests_total{method=\"PlanPick\",code=\"OK\"}"), 2.0);
   EXPECT_EQ(value("tubepick_rpc_requests_total{method=\"PlanPick\",code=\"INVALID_ARGUMENT\"}"), 1.0);

@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -31,8 +33,20 @@ using ::testing::HasSubstr;
 /// tubepick-server with stdout and stderr captured; killed if still running at destruction.
 class ServerProcess {
  public:
-  explicit ServerProcess(std::vector<std::string> args) {
+  /// `env`: NAME=VALUE entries added to (or replacing) this process's environment.
+  explicit ServerProcess(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
     args.insert(args.begin(), TUBEPICK_SERVER_BIN);
+    std::vector<std::string> environment = env;
+    for (char** e = environ; *e != nullptr; ++e) {
+      const std::string entry = *e;
+      const std::string name = entry.substr(0, entry.find('='));
+      if (std::none_of(env.begin(), env.end(),
+                       [&](const std::string& x) { return x.rfind(name + "=", 0) == 0; }))
+        environment.push_back(entry);
+    }
+    std::vector<char*> envp;
+    for (std::string& e : environment) envp.push_back(e.data());
+    envp.push_back(nullptr);
     int fds[2];
     if (::pipe(fds) != 0) throw std::runtime_error("pipe");
     posix_spawn_file_actions_t actions;
@@ -43,7 +57,7 @@ class ServerProcess {
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
+    const int rc = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[1]);
     if (rc != 0) throw std::runtime_error("posix_spawn failed");
@@ -90,6 +104,15 @@ class ServerProcess {
     return found;
   }
   void Signal(int signal) { ::kill(pid_, signal); }
+  /// Threads of the process now (/proc/PID/task), 0 when it is gone.
+  int ThreadCount() const {
+    std::error_code error;
+    int n = 0;
+    for (std::filesystem::directory_iterator it("/proc/" + std::to_string(pid_) + "/task", error), end;
+         !error && it != end; it.increment(error))
+      ++n;
+    return n;
+  }
   /// The exit status once the process exited within `timeout`.
   std::optional<int> WaitExit(std::chrono::milliseconds timeout) {
     WaitFor(
@@ -195,6 +218,70 @@ TEST(ServiceProcess, SigtermFinishesInFlightCallsAndExitsZero) {
   EXPECT_EQ(call_lines, 2);
   EXPECT_TRUE(saw_request_id);
   std::filesystem::remove_all(dir);
+}
+
+// One thread budget: with 4 workers on a host whose OMP_NUM_THREADS says 16, four concurrent
+// PlanPicks (modeling in OpenMP, simulation on Bullet worlds) run on at most workers × threads per
+// call threads, plus the handful gRPC and the server keep. Without the budget each worker's OpenMP
+// regions would start 15 more threads.
+TEST(ServiceProcess, ThreadsStayWithinWorkersTimesThreadsPerCallWhateverOmpNumThreadsSays) {
+  (void)BusyBinCloud();
+  ServerProcess process({"--address", "127.0.0.1:0", "--metrics-address", "127.0.0.1:0", "--workers", "4"},
+                        {"OMP_NUM_THREADS=16"});
+  const std::optional<std::string> port = process.WaitForMatch(kListening, std::chrono::seconds(20));
+  ASSERT_TRUE(port) << process.output();
+  const std::optional<std::string> metrics_port = process.WaitForMatch(kMetrics, std::chrono::seconds(5));
+  ASSERT_TRUE(metrics_port) << process.output();
+  const std::optional<std::string> per_call =
+      process.WaitForMatch(std::regex(R"(4 workers x ([0-9]+) threads per call)"), std::chrono::seconds(5));
+  ASSERT_TRUE(per_call) << process.output();
+  const int threads_per_call = std::stoi(*per_call);
+
+  auto channel = grpc::CreateChannel("127.0.0.1:" + *port, grpc::InsecureChannelCredentials());
+  auto stub = v1::PickPlannerService::NewStub(channel);
+  {  // one call first, so that gRPC's own threads are up before the idle count
+    grpc::ClientContext context;
+    SetTimeout(&context, std::chrono::seconds(30));
+    v1::ModelTubesResponse response;
+    ASSERT_TRUE(stub->ModelTubes(&context, ModelRequest(ThreeTubeCloud()), &response).ok());
+  }
+  const int idle = process.ThreadCount();
+  std::atomic<bool> done{false};
+  std::atomic<int> peak{0};
+  std::atomic<double> busiest{0};
+  std::thread sampler([&] {
+    const int metrics = std::stoi(*metrics_port);
+    while (!done) {
+      peak = std::max(peak.load(), process.ThreadCount());
+      busiest =
+          std::max(busiest.load(), MetricValue(ScrapeMetrics(metrics), "tubepick_workers_busy").value_or(0));
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  });
+  std::vector<std::future<grpc::Status>> calls;
+  for (int i = 0; i < 4; ++i) {
+    calls.push_back(std::async(std::launch::async, [&] {
+      grpc::ClientContext context;
+      SetTimeout(&context, std::chrono::seconds(240));
+      v1::PlanPickResponse response;
+      return stub->PlanPick(&context, PlanRequest(BusyBinCloud(), /*simulate=*/true), &response);
+    }));
+  }
+  for (auto& call : calls) {
+    const grpc::Status status = call.get();
+    EXPECT_TRUE(status.ok()) << status.error_message();
+  }
+  done = true;
+  sampler.join();
+  EXPECT_EQ(busiest.load(), 4.0);  // full load: every worker ran a call at once
+  // The workers exist before the idle count; each call may add threads_per_call - 1 for OpenMP and
+  // as many for Bullet; 4 more for gRPC's pollers and timers.
+  const int bound = idle + 4 * 2 * (threads_per_call - 1) + 4;
+  EXPECT_LE(peak.load(), bound) << "idle " << idle << ", threads per call " << threads_per_call;
+  std::printf(
+      "[ measure  ] threads: %d idle, %d peak under 4 concurrent PlanPicks (OMP_NUM_THREADS=16, "
+      "%d threads per call)\n",
+      idle, peak.load(), threads_per_call);
 }
 
 TEST(ServiceProcess, PrintConfigShowsTheEmbeddedDefault) {

@@ -192,7 +192,7 @@ TEST(ServiceStreamLimits, TooManyPointsAreRefusedAtTheHeaderWithTheUnaryCode) {
   writer->Write(header_only[0]);
   writer->WritesDone();
   const grpc::Status streamed = writer->Finish();
-  EXPECT_EQ(streamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(streamed.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(streamed.error_message(),
               HasSubstr(std::to_string(ThreeTubeCloud().size() / 12) +
                         " points, more than the limit of 1000 (planning.max_cloud_points)"));
@@ -214,51 +214,154 @@ void WaitForUploads(const TestServer& server, double n) {
   ASSERT_TRUE(reached) << "uploads never reached " << n;
 }
 
-TEST(ServiceStreamAdmission, UploadsInProgressCountAgainstAdmissionAndErrorsReleaseTheirSlot) {
-  TestServer server(TestConfig(1, 1));  // room for 2 admitted calls
+// A cloud over the byte limits is RESOURCE_EXHAUSTED on both RPCs: gRPC's own answer to a unary
+// message over max_message_bytes, and the stream header's over max_stream_bytes.
+TEST(ServiceStreamLimits, OversizeIsResourceExhaustedOnTheUnaryAndTheStreamedRpc) {
+  server::ServerConfig config = TestConfig(1, 1);
+  config.max_message_bytes = 1 << 20;
+  config.max_stream_bytes = 1 << 20;
+  TestServer server(config);
+  std::string big;
+  while (big.size() <= (1u << 20)) big += ThreeTubeCloud();  // ~1.1 MB, a whole number of points
+
+  grpc::ClientContext unary_context;
+  SetTimeout(&unary_context, std::chrono::seconds(30));
+  v1::PlanPickResponse unary_response;
+  const grpc::Status unary = server.stub().PlanPick(&unary_context, PlanRequest(big), &unary_response);
+  EXPECT_EQ(unary.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << unary.error_message();
+
+  const StreamResult streamed = SendStream(server.stub(), StreamMessages(big, kChunk));
+  EXPECT_EQ(streamed.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(streamed.status.error_message(),
+              HasSubstr("exceeds the limit of 1048576 bytes (server.max_stream_bytes)"));
+}
+
+/// A PlanPickStream that has sent its header (and nothing else yet).
+struct OpenUpload {
+  grpc::ClientContext context;
+  v1::PlanPickStreamResponse response;
+  std::unique_ptr<grpc::ClientWriter<v1::PlanPickStreamRequest>> writer;
+};
+
+std::unique_ptr<OpenUpload> OpenHeaderOnly(v1::PickPlannerService::Stub& stub,
+                                           const v1::PlanPickStreamRequest& header) {
+  auto upload = std::make_unique<OpenUpload>();
+  SetTimeout(&upload->context, std::chrono::seconds(120));
+  upload->writer = stub.PlanPickStream(&upload->context, &upload->response);
+  EXPECT_TRUE(upload->writer->Write(header));
+  return upload;
+}
+
+TEST(ServiceStreamAdmission, UploadsHaveTheirOwnLimitAndErrorsReleaseTheirSlot) {
+  server::ServerConfig config = TestConfig(1, 1);  // room for 2 planning calls
+  config.max_uploads = 2;
+  TestServer server(config);
   const auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
-  auto open = [&](grpc::ClientContext* context, v1::PlanPickStreamResponse* response) {
-    SetTimeout(context, std::chrono::seconds(60));
-    auto writer = server.stub().PlanPickStream(context, response);
-    EXPECT_TRUE(writer->Write(messages[0]));  // header only
-    return writer;
-  };
-  grpc::ClientContext ca, cb, cc;
-  v1::PlanPickStreamResponse ra, rb, rc;
-  auto a = open(&ca, &ra);
+  std::unique_ptr<OpenUpload> a = OpenHeaderOnly(server.stub(), messages[0]);
   WaitForUploads(server, 1);
-  auto b = open(&cb, &rb);
+  std::unique_ptr<OpenUpload> b = OpenHeaderOnly(server.stub(), messages[0]);
   WaitForUploads(server, 2);
-  // The third header finds both slots taken by uploads that have sent no chunk yet.
-  auto c = open(&cc, &rc);
-  c->WritesDone();
-  const grpc::Status rejected = c->Finish();
+  // The third header finds both upload slots taken by uploads that have sent no chunk yet.
+  std::unique_ptr<OpenUpload> c = OpenHeaderOnly(server.stub(), messages[0]);
+  c->writer->WritesDone();
+  const grpc::Status rejected = c->writer->Finish();
   EXPECT_EQ(rejected.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  EXPECT_THAT(rejected.error_message(), HasSubstr("planning queue full: 0 running, 2 queued"));
+  EXPECT_THAT(rejected.error_message(),
+              HasSubstr("uploads full: 2 PlanPickStream uploads in progress (server.max_uploads)"));
+
+  // The uploads hold no planning slot: a unary PlanPick runs meanwhile.
+  grpc::ClientContext unary_context;
+  SetTimeout(&unary_context, std::chrono::seconds(60));
+  v1::PlanPickResponse unary_response;
+  const grpc::Status unary =
+      server.stub().PlanPick(&unary_context, PlanRequest(ThreeTubeCloud()), &unary_response);
+  EXPECT_TRUE(unary.ok()) << unary.error_message();
 
   // A fails (duplicate chunk) and gives its slot back: a new stream D is admitted.
-  a->Write(messages[1]);
-  a->Write(messages[1]);
-  a->WritesDone();
-  EXPECT_EQ(a->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  a->writer->Write(messages[1]);
+  a->writer->Write(messages[1]);
+  a->writer->WritesDone();
+  EXPECT_EQ(a->writer->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   WaitForUploads(server, 1);
-  grpc::ClientContext cd;
-  v1::PlanPickStreamResponse rd;
-  auto d = open(&cd, &rd);
+  std::unique_ptr<OpenUpload> d = OpenHeaderOnly(server.stub(), messages[0]);
   WaitForUploads(server, 2);
-  for (auto* writer : {b.get(), d.get()}) {
-    for (std::size_t i = 1; i < messages.size(); ++i) ASSERT_TRUE(writer->Write(messages[i]));
-    writer->WritesDone();
+  for (OpenUpload* upload : {b.get(), d.get()}) {
+    for (std::size_t i = 1; i < messages.size(); ++i) ASSERT_TRUE(upload->writer->Write(messages[i]));
+    upload->writer->WritesDone();
   }
-  const grpc::Status sb = b->Finish(), sd = d->Finish();
+  const grpc::Status sb = b->writer->Finish(), sd = d->writer->Finish();
   EXPECT_TRUE(sb.ok()) << sb.error_message();
   EXPECT_TRUE(sd.ok()) << sd.error_message();
-  EXPECT_EQ(rb.response().tubes_size(), 3);
-  EXPECT_EQ(rd.response().tubes_size(), 3);
+  EXPECT_EQ(b->response.response().tubes_size(), 3);
+  EXPECT_EQ(d->response.response().tubes_size(), 3);
   const std::string metrics = ScrapeMetrics(server.metrics_port());
   EXPECT_EQ(MetricValue(metrics, "tubepick_rejected_total"), 1.0);
   EXPECT_EQ(MetricValue(metrics, "tubepick_stream_uploads"), 0.0);
   EXPECT_EQ(MetricValue(metrics, "tubepick_rpc_requests_total{method=\"PlanPickStream\",code=\"OK\"}"), 2.0);
+}
+
+// With the default limits, 12 clients that open a PlanPickStream, send the header and then stall
+// hold upload slots only: a unary PlanPick of a 2 M-point cloud finds every worker free and runs.
+TEST(ServiceStreamAdmission, StalledUploadsDoNotKeepPlanningOut) {
+  server::ServerConfig config;  // the embedded defaults, on free loopback ports
+  config.address = "127.0.0.1:0";
+  config.metrics_address = "127.0.0.1:0";
+  config.log_level = "warn";
+  TestServer server(config);
+  std::string two_million;  // the generated bin, repeated: ~2.3 M points
+  while (two_million.size() < 12 * 2'000'000u) two_million += BusyBinCloud();
+  const auto header = StreamMessages(two_million, 4 << 20)[0];
+  std::vector<std::unique_ptr<OpenUpload>> stalled;
+  for (int i = 0; i < 12; ++i) stalled.push_back(OpenHeaderOnly(*server.NewStub(), header));
+  WaitForUploads(server, 12);
+  const std::string before = ScrapeMetrics(server.metrics_port());
+  EXPECT_EQ(MetricValue(before, "tubepick_workers_busy"), 0.0);
+  EXPECT_EQ(MetricValue(before, "tubepick_queue_depth"), 0.0);
+
+  grpc::ClientContext context;
+  SetTimeout(&context, std::chrono::seconds(120));
+  v1::PlanPickResponse response;
+  const grpc::Status status = server.stub().PlanPick(&context, PlanRequest(two_million), &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_GT(response.tubes_size(), 3);
+  const std::string after = ScrapeMetrics(server.metrics_port());
+  EXPECT_EQ(MetricValue(after, "tubepick_rejected_total"), 0.0);
+  for (auto& upload : stalled) upload->context.TryCancel();
+}
+
+// An upload that goes quiet is ended after server.stream_idle_timeout with DEADLINE_EXCEEDED that
+// says so, and its slot comes back; one that keeps sending (slower than the timeout in total, but
+// never quiet that long) completes.
+TEST(ServiceStreamAdmission, AQuietUploadIsEndedAfterTheIdleTimeout) {
+  server::ServerConfig config = TestConfig(1, 1);
+  config.stream_idle_timeout = 0.4;
+  TestServer server(config);
+  const auto messages = StreamMessages(ThreeTubeCloud(), kChunk);
+  std::unique_ptr<OpenUpload> quiet = OpenHeaderOnly(server.stub(), messages[0]);
+  WaitForUploads(server, 1);
+  const grpc::Status ended = quiet->writer->Finish();
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_THAT(ended.error_message(), HasSubstr("no message for 0.4 s (server.stream_idle_timeout), 0 of "));
+  WaitForUploads(server, 0);
+
+  // Nothing at all, not even a header.
+  grpc::ClientContext silent_context;
+  SetTimeout(&silent_context, std::chrono::seconds(30));
+  v1::PlanPickStreamResponse silent_response;
+  auto silent = server.stub().PlanPickStream(&silent_context, &silent_response);
+  const grpc::Status silent_status = silent->Finish();
+  EXPECT_EQ(silent_status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_THAT(silent_status.error_message(), HasSubstr("before its header"));
+
+  std::unique_ptr<OpenUpload> steady = OpenHeaderOnly(server.stub(), messages[0]);
+  for (std::size_t i = 1; i < messages.size(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+    ASSERT_TRUE(steady->writer->Write(messages[i]));
+  }
+  steady->writer->WritesDone();
+  const grpc::Status done = steady->writer->Finish();
+  EXPECT_TRUE(done.ok()) << done.error_message();
+  EXPECT_EQ(steady->response.response().tubes_size(), 3);
 }
 
 }  // namespace

@@ -80,8 +80,8 @@ void CloudStreamAssembler::Add(const v1::PlanPickStreamRequest& message) {
                               " is not a multiple of 12 (float32 x, y, z per point)");
       }
       if (total > max_total_bytes_) {
-        throw InvalidArgument("header.total_bytes: " + std::to_string(total) + " exceeds the limit of " +
-                              std::to_string(max_total_bytes_) + " bytes (server.max_stream_bytes)");
+        throw TooLarge("header.total_bytes: " + std::to_string(total) + " exceeds the limit of " +
+                       std::to_string(max_total_bytes_) + " bytes (server.max_stream_bytes)");
       }
       if (header.chunk_count() == 0)
         throw InvalidArgument("header.chunk_count: 0, but at least 1 chunk must follow");

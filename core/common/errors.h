@@ -12,6 +12,15 @@ class InvalidArgument : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// A request over a configured size limit (points, bytes): a caller mistake, so it is an
+/// InvalidArgument to code that catches those, but the server answers RESOURCE_EXHAUSTED, the code
+/// gRPC itself gives a message over its size limit, so that every oversize request (unary or
+/// streamed, over the byte or the point limit) gets the one code.
+class TooLarge : public InvalidArgument {
+ public:
+  using InvalidArgument::InvalidArgument;
+};
+
 /// The input is well formed but does not fit the cell it is meant for: e.g. a cloud whose unit or
 /// sensor pose is wrong, so that it misses the bin. The message gives the evidence and the likely
 /// cause; the server maps it to gRPC FAILED_PRECONDITION, the CLI to exit code 4.

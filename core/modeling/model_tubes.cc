@@ -1,7 +1,5 @@
 #include "core/modeling/model_tubes.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/common/errors.h"
+#include "core/common/thread_budget.h"
 #include "core/modeling/cloud_io.h"
 #include "core/modeling/cloud_prepare.h"
 #include "core/modeling/cylinder_fit.h"
@@ -59,10 +58,6 @@ struct WorkingCloud {
   }
 };
 
-int ThreadCount(std::uint32_t requested) {
-  return requested == 0 ? omp_get_max_threads() : static_cast<int>(requested);
-}
-
 }  // namespace
 
 ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params, const StopToken* stop) {
@@ -94,7 +89,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     const Points& surface =
         params.normals.search_surface == SearchSurface::kRaw ? result.raw_Bin : work.cloud.points;
     OrientedPoints oriented =
-        EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop);
+        EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop, params.threads);
     std::vector<std::uint32_t> valid;
     valid.reserve(oriented.size());
     for (std::uint32_t i = 0; i < oriented.size(); ++i) {
@@ -136,7 +131,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
 
   // 3. Region-growing segmentation.
   t0 = Clock::now();
-  const std::vector<Segment> segments = SegmentRegions(cloud, params.segmentation, stop);
+  const std::vector<Segment> segments = SegmentRegions(cloud, params.segmentation, stop, params.threads);
   result.segment_count = static_cast<std::uint32_t>(segments.size());
   result.segment_of_point.assign(cloud.size(), -1);
   std::uint64_t segmented = 0;
@@ -152,7 +147,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   std::vector<std::vector<FittedCylinder>> per_segment(segments.size());
   std::exception_ptr failure;
   const int n_segments = static_cast<int>(segments.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ThreadCount(params.threads))
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ResolveThreads(params.threads))
   for (int s = 0; s < n_segments; ++s) {
     try {
       per_segment[s] = FitCylinders(cloud, segments[s], static_cast<std::uint32_t>(s), params.cylinders,

@@ -163,14 +163,12 @@ Eigen::Vector3i NeighbourGrid::UnclampedCellOf(const Eigen::Vector3f& p) const {
   return c;
 }
 
-int NeighbourGrid::MaxThreads() { return omp_get_max_threads(); }
-
-void NeighbourGrid::ForEachGroup(const Points& queries, const StopToken* stop,
+void NeighbourGrid::ForEachGroup(const Points& queries, int threads, const StopToken* stop,
                                  const GroupVisit& visit) const {
   const QueryGroups groups = GroupQueries(queries);
   const std::int64_t n_groups = static_cast<std::int64_t>(groups.begin.size()) - 1;
   std::atomic<bool> stopped{false};
-#pragma omp parallel
+#pragma omp parallel num_threads(threads)
   {
     Block block;
     const int thread = omp_get_thread_num();

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "core/common/stop_token.h"
+#include "core/common/thread_budget.h"
 #include "core/common/types.h"
 
 namespace tubepick::internal {
@@ -64,11 +65,12 @@ class NeighbourGrid {
 
   /// Calls visit(block, begin, end, state) for groups of queries sharing a grid cell, with that
   /// cell's block, so that the block is gathered once per group. [begin, end) holds indices into
-  /// `queries`. Groups run in parallel (OpenMP); `state` is a default-constructed State per
-  /// thread. Stops early (leaving queries unvisited) once `stop` says so: the caller then calls
-  /// ThrowIfStopped.
+  /// `queries`. Groups run in parallel on ResolveThreads(threads) OpenMP threads; `state` is a
+  /// default-constructed State per thread. Stops early (leaving queries unvisited) once `stop` says so: the
+  /// caller then calls ThrowIfStopped.
   template <typename State, typename Visit>
-  void ForEachQueryBlock(const Points& queries, const StopToken* stop, Visit&& visit) const;
+  void ForEachQueryBlock(const Points& queries, std::uint32_t threads, const StopToken* stop,
+                         Visit&& visit) const;
 
   /// Memory reused between NearestInBlock() calls of one thread, and a squared search radius
   /// guessed from the previous (nearby) query.
@@ -101,9 +103,9 @@ class NeighbourGrid {
 
   using GroupVisit =
       std::function<void(int thread, const Block&, const std::uint32_t*, const std::uint32_t*)>;
-  /// The OpenMP loop behind ForEachQueryBlock(); `thread` is in [0, MaxThreads()).
-  void ForEachGroup(const Points& queries, const StopToken* stop, const GroupVisit& visit) const;
-  static int MaxThreads();
+  /// The OpenMP loop behind ForEachQueryBlock() on `threads` ≥ 1 threads; `thread` is in
+  /// [0, threads).
+  void ForEachGroup(const Points& queries, int threads, const StopToken* stop, const GroupVisit& visit) const;
 
   struct QueryGroups {
     /// Query indices, grouped.
@@ -163,13 +165,15 @@ class NeighbourGrid {
 };
 
 template <typename State, typename Visit>
-void NeighbourGrid::ForEachQueryBlock(const Points& queries, const StopToken* stop, Visit&& visit) const {
+void NeighbourGrid::ForEachQueryBlock(const Points& queries, std::uint32_t threads, const StopToken* stop,
+                                      Visit&& visit) const {
   // One State per thread, each on its own cache lines.
   struct alignas(64) PaddedState {
     State state{};
   };
-  std::vector<PaddedState> states(static_cast<std::size_t>(MaxThreads()));
-  ForEachGroup(queries, stop,
+  const int width = ResolveThreads(threads);
+  std::vector<PaddedState> states(static_cast<std::size_t>(width));
+  ForEachGroup(queries, width, stop,
                [&](int thread, const Block& block, const std::uint32_t* begin, const std::uint32_t* end) {
                  visit(block, begin, end, states[static_cast<std::size_t>(thread)].state);
                });

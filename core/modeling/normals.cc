@@ -155,7 +155,8 @@ void NormalFromMoments(const Moments& m, const Eigen::Vector3f& q, const Eigen::
 }  // namespace
 
 OrientedPoints EstimateNormals(const Points& query_Bin, const Points& surface_Bin, const NormalParams& params,
-                               const Eigen::Vector3f& viewpoint_Bin, const StopToken* stop) {
+                               const Eigen::Vector3f& viewpoint_Bin, const StopToken* stop,
+                               std::uint32_t threads) {
   if (!(params.radius > 0.0) || !std::isfinite(params.radius)) {
     throw InvalidArgument("normals.radius: must be a positive number of metres, got " +
                           std::to_string(params.radius));
@@ -199,7 +200,7 @@ OrientedPoints EstimateNormals(const Points& query_Bin, const Points& surface_Bi
       NormalFromMoments(moments, q, viewpoint_Bin, &out.normals[*it], &out.curvature[*it]);
     }
   };
-  grid.ForEachQueryBlock<State>(query_Bin, stop, estimate);
+  grid.ForEachQueryBlock<State>(query_Bin, threads, stop, estimate);
   ThrowIfStopped(stop, "normals");
   return out;
 }

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+
 #include "core/common/stop_token.h"
 #include "core/common/types.h"
 
@@ -20,10 +22,11 @@ struct NormalParams {
 /// Estimates a unit normal and the curvature λ0/(λ0+λ1+λ2) at each query point from the
 /// covariance of its neighbours in `surface` within params.radius (pcl::NormalEstimationOMP).
 /// Normals are flipped to face `viewpoint_Bin` (the sensor origin). Points with fewer than 3
-/// neighbours get NaN normal and curvature (the caller drops them). Parallel with OpenMP;
-/// the result does not depend on the thread count.
+/// neighbours get NaN normal and curvature (the caller drops them). Runs on
+/// ResolveThreads(threads) OpenMP threads; the result does not depend on the thread count.
 /// @throws InvalidArgument for radius <= 0.
 OrientedPoints EstimateNormals(const Points& query_Bin, const Points& surface_Bin, const NormalParams& params,
-                               const Eigen::Vector3f& viewpoint_Bin, const StopToken* stop = nullptr);
+                               const Eigen::Vector3f& viewpoint_Bin, const StopToken* stop = nullptr,
+                               std::uint32_t threads = 0);
 
 }  // namespace tubepick

@@ -39,7 +39,7 @@ void Validate(const OrientedPoints& cloud, const SegmentationParams& params) {
 }  // namespace
 
 std::vector<Segment> SegmentRegions(const OrientedPoints& cloud, const SegmentationParams& params,
-                                    const StopToken* stop) {
+                                    const StopToken* stop, std::uint32_t threads) {
   Validate(cloud, params);
 
   // Points with a non-finite position, normal or curvature take no part (never in a segment).
@@ -82,7 +82,7 @@ std::vector<Segment> SegmentRegions(const OrientedPoints& cloud, const Segmentat
       for (std::size_t m = 0; m < state.neighbours.size(); ++m) row[m] = state.neighbours[m].second;
     }
   };
-  grid.ForEachQueryBlock<State>(points, stop, find_neighbours);
+  grid.ForEachQueryBlock<State>(points, threads, stop, find_neighbours);
   ThrowIfStopped(stop, "segmentation");
 
   // Seeds in order of increasing curvature, ties by index.

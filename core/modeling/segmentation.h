@@ -31,11 +31,11 @@ using Segment = std::vector<std::uint32_t>;
 /// Splits the cloud into smooth regions. Deterministic: seeds are taken in order of increasing
 /// curvature (ties by index). Segments are returned in the order they were grown, indices
 /// ascending within a segment; each index appears in at most one segment. Points with a
-/// non-finite position, normal or curvature are in no segment. Parallel with OpenMP (the k-NN
-/// graph); the result does not depend on the thread count.
+/// non-finite position, normal or curvature are in no segment. The k-NN graph is built on
+/// ResolveThreads(threads) OpenMP threads; the result does not depend on the thread count.
 /// @throws InvalidArgument for neighbours == 0, a non-positive smoothness threshold,
 /// min_cluster_size > max_cluster_size, or normals/curvature sizes that differ from the points'.
 std::vector<Segment> SegmentRegions(const OrientedPoints& cloud, const SegmentationParams& params,
-                                    const StopToken* stop = nullptr);
+                                    const StopToken* stop = nullptr, std::uint32_t threads = 0);
 
 }  // namespace tubepick

@@ -95,7 +95,7 @@ void ExpectOrderedByCost(const v1::PlanPickResponse& r) {
 TEST(RunModelTubes, FindsTheThreeTubes) {
   const PlanningDefaults defaults;
   const PlanningJob job = ValidatePlanPick(Request(ThreeTubesCloud(), 5), defaults);
-  const v1::ModelTubesResponse r = RunModelTubes(job, nullptr);
+  const v1::ModelTubesResponse r = RunModelTubes(job, 1, nullptr);
   ASSERT_EQ(r.tubes_size(), 3);
   for (const v1::Tube& t : r.tubes()) {
     EXPECT_NEAR(t.length(), 0.40, 0.02) << "tube " << t.id();
@@ -117,8 +117,8 @@ TEST(RunModelTubes, MillimetreCloudGivesTheSameTubes) {
   for (Eigen::Vector3f& p : scaled) p *= 1000.0f;
   v1::PlanPickRequest request = Request(Encode(scaled));
   request.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);
-  const v1::ModelTubesResponse a = RunModelTubes(metres, nullptr);
-  const v1::ModelTubesResponse b = RunModelTubes(ValidatePlanPick(request, defaults), nullptr);
+  const v1::ModelTubesResponse a = RunModelTubes(metres, 1, nullptr);
+  const v1::ModelTubesResponse b = RunModelTubes(ValidatePlanPick(request, defaults), 1, nullptr);
   ASSERT_EQ(a.tubes_size(), b.tubes_size());
   for (int i = 0; i < a.tubes_size(); ++i) EXPECT_NEAR(a.tubes(i).length(), b.tubes(i).length(), 1e-3);
 }
@@ -127,7 +127,7 @@ TEST(RunModelTubes, AllNonFiniteCloudIsACallerMistake) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const PlanningJob job =
       ValidatePlanPick(Request(Encode(Points(100, Eigen::Vector3f(nan, nan, nan)))), PlanningDefaults{});
-  EXPECT_THROW(RunModelTubes(job, nullptr), InvalidArgument);
+  EXPECT_THROW(RunModelTubes(job, 1, nullptr), InvalidArgument);
 }
 
 TEST(RunPlanPick, UnoccludedTubesNeedNoSimulation) {
@@ -227,10 +227,10 @@ TEST(RunPlanPick, StoppedTokenCancels) {
   } catch (const Cancelled& e) {
     EXPECT_FALSE(e.deadline_exceeded());
   }
-  EXPECT_THROW(RunModelTubes(job, &stopped), Cancelled);
+  EXPECT_THROW(RunModelTubes(job, 1, &stopped), Cancelled);
   const StopToken expired(StopToken::Clock::now() - std::chrono::milliseconds(1));
   try {
-    RunModelTubes(job, &expired);
+    RunModelTubes(job, 1, &expired);
     FAIL() << "expected Cancelled";
   } catch (const Cancelled& e) {
     EXPECT_TRUE(e.deadline_exceeded());
@@ -261,7 +261,7 @@ TEST(RunPlanPick, StopDuringSimulationEndsTheCallPromptly) {
   defaults.simulation.gripper_speed = 0.002;
   const PlanningJob job = ValidatePlanPick(Request(WeaveCloud()), defaults);
   const auto model_start = std::chrono::steady_clock::now();
-  (void)RunModelTubes(job, nullptr);
+  (void)RunModelTubes(job, 1, nullptr);
   const auto modeling = std::chrono::steady_clock::now() - model_start;
 
   StopToken token;

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/common/errors.h"
+#include "core/common/thread_budget.h"
 #include "core/testing/error_of.h"
 
 namespace tubepick::server {
@@ -90,7 +91,18 @@ void ExpectSameConfig(const ServerConfig& a, const ServerConfig& b) {
   EXPECT_EQ(a.planning.profile, b.planning.profile);
   EXPECT_EQ(a.planning.seed, b.planning.seed);
   EXPECT_EQ(a.planning.max_cloud_points, b.planning.max_cloud_points);
-  EXPECT_EQ(a.planning.simulation_threads, b.planning.simulation_threads);
+  EXPECT_EQ(a.threads_per_call, b.threads_per_call);
+  EXPECT_EQ(a.max_uploads, b.max_uploads);
+  EXPECT_EQ(a.stream_idle_timeout, b.stream_idle_timeout);
+  EXPECT_EQ(a.max_call_time, b.max_call_time);
+  EXPECT_EQ(a.resource_quota_bytes, b.resource_quota_bytes);
+  EXPECT_EQ(a.connection.keepalive_time, b.connection.keepalive_time);
+  EXPECT_EQ(a.connection.keepalive_timeout, b.connection.keepalive_timeout);
+  EXPECT_EQ(a.connection.min_client_ping_interval, b.connection.min_client_ping_interval);
+  EXPECT_EQ(a.connection.max_idle, b.connection.max_idle);
+  EXPECT_EQ(a.connection.max_age, b.connection.max_age);
+  EXPECT_EQ(a.connection.max_age_grace, b.connection.max_age_grace);
+  EXPECT_EQ(a.connection.max_concurrent_streams, b.connection.max_concurrent_streams);
   ASSERT_EQ(a.planning.profiles.size(), b.planning.profiles.size());
   for (const auto& [name, params] : a.planning.profiles) {
     ASSERT_TRUE(b.planning.profiles.count(name)) << name;
@@ -124,7 +136,8 @@ TEST(ServerConfig, EmbeddedYamlParsesToExactlyTheDefaults) {
   const std::string yaml(EmbeddedServerConfigYaml());
   // Every section is spelled out (an operator copies it as a template).
   for (const char* key : {"server:", "tls:", "planning:", "simulation:", "cell:", "cell_file:",
-                          "pose_in_bin:", "wall_thickness:", "require_client_cert:", "simulation_threads:"}) {
+                          "pose_in_bin:", "wall_thickness:", "require_client_cert:", "threads_per_call:",
+                          "stream_idle_timeout:", "connection:", "keepalive_time:"}) {
     EXPECT_THAT(yaml, HasSubstr(key));
   }
   ExpectSameConfig(ParseServerConfig(yaml), ServerConfig{});
@@ -148,6 +161,12 @@ server:
   max_message_bytes: 2097152
   max_stream_bytes: 1200
   shutdown_grace: 2.5
+  threads_per_call: 2
+  max_uploads: 3
+  stream_idle_timeout: 4.5
+  max_call_time: 30
+  resource_quota_bytes: 8388608
+  connection: {keepalive_time: 20, max_idle: 60, max_concurrent_streams: 4}
   metrics_address: ""
   reflection: false
   log_level: debug
@@ -158,7 +177,6 @@ planning:
   profile: thesis
   seed: 99
   max_cloud_points: 1000
-  simulation_threads: 2
   simulation: {gripper_speed: 0.2, solver_iterations: 20, wall_thickness: 0.1}
 )",
                                            dir.string());
@@ -181,11 +199,32 @@ planning:
   EXPECT_EQ(c.planning.profile, "thesis");
   EXPECT_EQ(c.planning.seed, 99u);
   EXPECT_EQ(c.planning.max_cloud_points, 1000u);
-  EXPECT_EQ(c.planning.simulation_threads, 2u);
+  EXPECT_EQ(c.threads_per_call, 2u);
+  EXPECT_EQ(c.max_uploads, 3u);
+  EXPECT_EQ(c.stream_idle_timeout, 4.5);
+  EXPECT_EQ(c.max_call_time, 30.0);
+  EXPECT_EQ(c.resource_quota_bytes, 8388608u);
+  EXPECT_EQ(c.connection.keepalive_time, 20.0);
+  EXPECT_EQ(c.connection.max_idle, 60.0);
+  EXPECT_EQ(c.connection.max_concurrent_streams, 4u);
+  EXPECT_EQ(c.connection.max_age, ConnectionLimits{}.max_age);
   EXPECT_EQ(c.planning.simulation.gripper_speed, 0.2);
   EXPECT_EQ(c.planning.simulation.solver_iterations, 20);
   EXPECT_EQ(c.planning.simulation.wall_thickness, 0.1);
   EXPECT_EQ(c.planning.simulation.time_step, physics::TrajectorySimParams{}.time_step);
+}
+
+TEST(ServerConfig, ThreadBudgetSplitsTheAvailableCoresAmongWorkers) {
+  ServerConfig c;
+  c.workers = 0;
+  EXPECT_EQ(WorkerCount(c), static_cast<std::uint32_t>(CoresAvailable()));
+  EXPECT_EQ(ThreadsPerCall(c), 1u);  // one worker per core, one thread each
+  c.workers = 1;
+  EXPECT_EQ(ThreadsPerCall(c), static_cast<std::uint32_t>(CoresAvailable()));
+  c.workers = 4 * static_cast<std::uint32_t>(CoresAvailable());
+  EXPECT_EQ(ThreadsPerCall(c), 1u);  // more workers than cores: never 0
+  c.threads_per_call = 3;
+  EXPECT_EQ(ThreadsPerCall(c), 3u);  // an explicit budget is kept
 }
 
 TEST(ServerConfig, UnknownKeysAreErrorsWithTheirPath) {
@@ -236,7 +275,8 @@ TEST(ServerConfig, RangeChecksNameTheKeyAndValue) {
   EXPECT_THAT(ParseError("server: {max_message_bytes: 2147483648}"),
               AllOf(HasSubstr("server.max_message_bytes"), HasSubstr("2147483648")));
   EXPECT_NO_THROW(ParseServerConfig("server: {max_message_bytes: 1048576}"));
-  EXPECT_NO_THROW(ParseServerConfig("server: {max_message_bytes: 2147483647}"));
+  EXPECT_NO_THROW(
+      ParseServerConfig("server: {max_message_bytes: 2147483647, resource_quota_bytes: 4294967296}"));
   EXPECT_THAT(ParseError("server: {max_stream_bytes: 11}"), HasSubstr("server.max_stream_bytes"));
   EXPECT_THAT(ParseError("server: {workers: 5000}"), HasSubstr("server.workers"));
   EXPECT_THAT(ParseError("server: {shutdown_grace: -1}"), HasSubstr("server.shutdown_grace"));
@@ -245,7 +285,19 @@ TEST(ServerConfig, RangeChecksNameTheKeyAndValue) {
   EXPECT_THAT(ParseError("server: {log_format: xml}"),
               AllOf(HasSubstr("server.log_format"), HasSubstr("xml")));
   EXPECT_THAT(ParseError("planning: {max_cloud_points: 0}"), HasSubstr("planning.max_cloud_points"));
-  EXPECT_THAT(ParseError("planning: {simulation_threads: 2000}"), HasSubstr("planning.simulation_threads"));
+  EXPECT_THAT(ParseError("server: {threads_per_call: 2000}"), HasSubstr("server.threads_per_call"));
+  EXPECT_THAT(ParseError("server: {max_uploads: 0}"), HasSubstr("server.max_uploads"));
+  EXPECT_THAT(ParseError("server: {stream_idle_timeout: 0}"), HasSubstr("server.stream_idle_timeout"));
+  EXPECT_THAT(ParseError("server: {max_call_time: -1}"), HasSubstr("server.max_call_time"));
+  EXPECT_THAT(ParseError("server: {resource_quota_bytes: 1048575}"),
+              AllOf(HasSubstr("server.resource_quota_bytes"), HasSubstr("max_message_bytes")));
+  EXPECT_THAT(ParseError("server: {connection: {keepalive_timeout: 0}}"),
+              HasSubstr("server.connection.keepalive_timeout"));
+  EXPECT_THAT(ParseError("server: {connection: {max_concurrent_streams: 0}}"),
+              HasSubstr("server.connection.max_concurrent_streams"));
+  EXPECT_THAT(ParseError("server: {connection: {keepalive: 1}}"), HasSubstr("server.connection.keepalive"));
+  // The per-call thread budget replaced planning.simulation_threads.
+  EXPECT_THAT(ParseError("planning: {simulation_threads: 2}"), HasSubstr("planning.simulation_threads"));
   EXPECT_THAT(ParseError("planning: {simulation: {time_step: 0}}"),
               AllOf(HasSubstr("planning.simulation.time_step"), HasSubstr("0")));
   EXPECT_THAT(ParseError("planning: {simulation: {solver_iterations: 0}}"),

@@ -3,8 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <random>
+#include <set>
+#include <thread>
 #include <vector>
+
+#include <omp.h>
 
 #include <gtest/gtest.h>
 
@@ -65,7 +70,7 @@ void ExpectMatchesBruteForce(const Points& points, const NeighbourGrid& grid, co
     NeighbourGrid::NearestScratch scratch;
     std::vector<Neighbour> out;
   };
-  grid.ForEachQueryBlock<State>(queries, nullptr,
+  grid.ForEachQueryBlock<State>(queries, 2, nullptr,
                                 [&](const NeighbourGrid::Block& block, const std::uint32_t* begin,
                                     const std::uint32_t* end, State& state) {
                                   for (const std::uint32_t* it = begin; it != end; ++it) {
@@ -157,11 +162,44 @@ TEST(NeighbourGrid, EveryFiniteQueryIsVisitedOnce) {
   std::vector<int> visits(queries.size(), 0);
   struct State {};
   grid.ForEachQueryBlock<State>(
-      queries, nullptr,
+      queries, 0, nullptr,
       [&](const NeighbourGrid::Block&, const std::uint32_t* begin, const std::uint32_t* end, State&) {
         for (const std::uint32_t* it = begin; it != end; ++it) ++visits[*it];
       });
   for (std::size_t i = 0; i < queries.size(); ++i) EXPECT_EQ(visits[i], queries[i].allFinite() ? 1 : 0) << i;
+}
+
+// The width of the parallel loop is the caller's `threads`, whatever OpenMP's default (what
+// OMP_NUM_THREADS sets) says: a 16-core default must not turn a 2-thread call into 16 threads.
+TEST(NeighbourGrid, ParallelWidthIsTheCallersNotOpenMpDefault) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Points points(20000);
+  for (Eigen::Vector3f& p : points) p = Eigen::Vector3f(u(rng), u(rng), u(rng));
+  const NeighbourGrid grid(points, 0.05f);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(16);
+  for (const std::uint32_t threads : {1u, 2u}) {
+    std::mutex mu;
+    std::set<std::thread::id> seen;
+    struct State {
+      int unused = 0;
+    };
+    std::vector<State*> states;
+    grid.ForEachQueryBlock<State>(
+        points, threads, nullptr,
+        [&](const NeighbourGrid::Block&, const std::uint32_t*, const std::uint32_t*, State& state) {
+          std::lock_guard lock(mu);
+          seen.insert(std::this_thread::get_id());
+          if (std::find(states.begin(), states.end(), &state) == states.end()) states.push_back(&state);
+        });
+    EXPECT_LE(seen.size(), threads) << threads;
+    EXPECT_LE(states.size(), threads) << threads;
+    if (threads == 1) {
+      EXPECT_TRUE(seen.count(std::this_thread::get_id()));
+    }
+  }
+  omp_set_num_threads(saved);
 }
 
 TEST(NeighbourGrid, SuggestedCellSizeTracksDensity) {
