@@ -8,6 +8,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/ray_intersect.h"
+#include "core/common/thread_budget.h"
 #include "physics/seeds.h"
 
 namespace tubepick::physics {
@@ -145,6 +146,7 @@ void ScannerParams::Validate() const {
   require(k.fy > 0.0 && std::isfinite(k.fy), "intrinsics.fy", k.fy, "> 0 px");
   require(std::isfinite(k.cx), "intrinsics.cx", k.cx, "a finite number");
   require(std::isfinite(k.cy), "intrinsics.cy", k.cy, "a finite number");
+  require(threads <= 1024, "threads", threads, "0 (all cores) .. 1024");
   require(depth_noise >= 0.0 && depth_noise < 0.1, "depth_noise", depth_noise, "0 ≤ σ < 0.1 m");
   require(max_incidence_angle > 0.0 && max_incidence_angle <= M_PI / 2, "max_incidence_angle",
           max_incidence_angle, "0 < angle ≤ π/2 rad");
@@ -187,7 +189,7 @@ ScanResult RenderScan(const ScannerScene& scene_Bin, const Eigen::Isometry3d& X_
   const double min_cos = std::cos(params.max_incidence_angle);
 
   std::vector<RowOutput> rows(k.height);
-#pragma omp parallel for schedule(dynamic, 4)
+#pragma omp parallel for schedule(dynamic, 4) num_threads(ResolveThreads(params.threads))
   for (int j = 0; j < k.height; ++j) {
     std::vector<double> depth(k.width, kInf);
     std::vector<int> winner(k.width, -1);  // primitive index, −1 none, −2 ground

@@ -53,6 +53,9 @@ struct ScannerParams {
   /// ScanScene only: render the bin solids and the ground plane.
   bool render_bin = true;
   bool render_ground = true;
+  /// Threads that cast the rows' rays (OpenMP); 0 = the cores the process may use. The scan does
+  /// not depend on it.
+  std::uint32_t threads = 0;
 
   /// @throws InvalidArgument naming the first bad field and its value.
   void Validate() const;

@@ -18,6 +18,7 @@
 #include "clients/cli/inputs/scene_files.h"
 #include "clients/cli/inputs/sim_scene.h"
 #include "core/common/errors.h"
+#include "core/common/thread_budget.h"
 #include "core/evaluation/virtual_labelling.h"
 #include "core/modeling/model_tubes.h"
 #include "physics/tube_config_io.h"
@@ -250,7 +251,7 @@ void Run(const EvalOptions& o) {
   if (o.joining == "global") params.modeling.joining.strategy = JoiningStrategy::kGlobal;
   const std::uint32_t jobs = std::max<std::uint32_t>(1, o.jobs);
   if (jobs > 1 && params.modeling.threads == 0) {
-    params.modeling.threads = std::max<std::uint32_t>(1, std::thread::hardware_concurrency() / jobs);
+    params.modeling.threads = std::max<std::uint32_t>(1, static_cast<std::uint32_t>(CoresAvailable()) / jobs);
   }
   params.Validate();
   const EvaluationParams eval_params;
