@@ -75,7 +75,7 @@ TEST(LoadAgainstServer, CountsOkAndInvalidArgumentRoundRobin) {
   LocalServer server(/*workers=*/2, /*queue=*/8);
   LoadOptions o;
   o.channel.target = server.target();
-  o.rpc = LoadRpc::kModelTubes;
+  o.rpcs = {LoadRpc::kModelTubes};
   o.concurrency = 2;
   o.total = 6;
   o.warmup = 2;
@@ -115,7 +115,7 @@ TEST(LoadAgainstServer, PlanPickStreamInSmallChunks) {
   LocalServer server(/*workers=*/1, /*queue=*/4);
   LoadOptions o;
   o.channel.target = server.target();
-  o.rpc = LoadRpc::kPlanPickStream;
+  o.rpcs = {LoadRpc::kPlanPickStream};
   o.disable_simulation = true;
   o.chunk_bytes = 64 * 1024;  // ~1.4 MB cloud → 22 chunks
   o.concurrency = 1;
@@ -126,11 +126,47 @@ TEST(LoadAgainstServer, PlanPickStreamInSmallChunks) {
   ExpectOrdered(r.latency);
 }
 
+TEST(LoadAgainstServer, AMixOfRpcsIsReportedEachAndTogether) {
+  LocalServer server(/*workers=*/2, /*queue=*/4);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpcs = {LoadRpc::kPlanPick, LoadRpc::kPlanPickStream};
+  o.disable_simulation = true;
+  o.chunk_bytes = 256 * 1024;
+  o.concurrency = 2;
+  o.total = 4;
+  const LoadReport r = RunLoad(o, {GoodCloud()});
+  EXPECT_EQ(r.rpc, "plan,plan-stream");
+  EXPECT_EQ(r.method,
+            "tubepick.v1.PickPlannerService/PlanPick, tubepick.v1.PickPlannerService/PlanPickStream");
+  EXPECT_EQ(r.total, 4u);
+  EXPECT_EQ(r.ok, 4u) << FormatLoadReportText(r);
+  ASSERT_EQ(r.by_rpc.size(), 2u);
+  // One thread each: both start a call at once, the other two go to whichever finishes first.
+  EXPECT_EQ(r.by_rpc[0].rpc, "plan");
+  EXPECT_EQ(r.by_rpc[0].method, "tubepick.v1.PickPlannerService/PlanPick");
+  EXPECT_GE(r.by_rpc[0].total, 1u);
+  EXPECT_EQ(r.by_rpc[0].ok, r.by_rpc[0].total);
+  EXPECT_EQ(r.by_rpc[1].rpc, "plan-stream");
+  EXPECT_GE(r.by_rpc[1].total, 1u);
+  EXPECT_EQ(r.by_rpc[1].status_counts.at("OK"), r.by_rpc[1].total);
+  EXPECT_EQ(r.by_rpc[0].total + r.by_rpc[1].total, 4u);
+  ExpectOrdered(r.by_rpc[0].latency);
+  ExpectOrdered(r.by_rpc[1].latency);
+  const std::string text = FormatLoadReportText(r);
+  EXPECT_NE(text.find("By RPC"), std::string::npos) << text;
+  EXPECT_NE(text.find("plan-stream"), std::string::npos) << text;
+  EXPECT_NE(FormatLoadReportJson(r).find("\"by_rpc\""), std::string::npos);
+
+  o.concurrency = 3;  // not a multiple of two RPCs
+  EXPECT_THROW(RunLoad(o, {GoodCloud()}), InvalidArgument);
+}
+
 TEST(LoadAgainstServer, ExpiredDeadlinesAreCountedByCode) {
   LocalServer server(/*workers=*/1, /*queue=*/4);
   LoadOptions o;
   o.channel.target = server.target();
-  o.rpc = LoadRpc::kPlanPick;
+  o.rpcs = {LoadRpc::kPlanPick};
   o.concurrency = 1;
   o.total = 2;
   o.deadline_seconds = 0.001;  // far below one plan of 2.3 M points
@@ -146,7 +182,7 @@ TEST(LoadAgainstServer, FullQueueIsCountedAsResourceExhausted) {
   LocalServer server(/*workers=*/1, /*queue=*/1);
   LoadOptions o;
   o.channel.target = server.target();
-  o.rpc = LoadRpc::kModelTubes;
+  o.rpcs = {LoadRpc::kModelTubes};
   o.concurrency = 4;
   o.total = 8;
   const LoadReport r = RunLoad(o, {{"full", PackXyz(SceneCloud(1)), v1::LENGTH_UNIT_METRE}});

@@ -2,7 +2,10 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
+#include <optional>
 
 #include "clients/cli/inputs/cli_inputs.h"
 #include "clients/cli/load/load_engine.h"
@@ -20,6 +23,8 @@ struct LoadCommandOptions {
   std::uint64_t seed = 0;
   std::size_t chunk_kib = 1024;
   bool fail_on_error = false;
+  /// Fail when the server's median RSS grows more than this, percent; unset = no memory check.
+  std::optional<double> max_rss_growth;
 };
 
 v1::LengthUnit ProtoUnit(const std::string& unit) {
@@ -29,7 +34,7 @@ v1::LengthUnit ProtoUnit(const std::string& unit) {
 }
 
 void Run(LoadCommandOptions& o, bool seed_given) {
-  o.load.rpc = ParseLoadRpc(o.rpc);
+  o.load.rpcs = ParseLoadRpcs(o.rpc);
   if (seed_given) o.load.seed = o.seed;
   o.load.chunk_bytes = o.chunk_kib * 1024;
   const std::vector<LoadCloud> clouds = ReadLoadClouds(o.clouds_dir, ProtoUnit(o.unit));
@@ -43,10 +48,21 @@ void Run(LoadCommandOptions& o, bool seed_given) {
     WriteTextFile(o.json_path, FormatLoadReportJson(report));
     fmt::print("wrote {}\n", o.json_path);
   }
+  bool failed = false;
   if (o.fail_on_error && report.ok < report.total) {
     fmt::print(stderr, "load: {} of {} calls failed\n", report.total - report.ok, report.total);
-    throw CLI::RuntimeError(1);
+    failed = true;
   }
+  if (o.max_rss_growth && report.rss) {
+    // Half the scrapes a window should hold, at least 3: fewer means the endpoint was not answering.
+    const auto min_samples = static_cast<std::size_t>(
+        std::max(3.0, std::floor(0.5 * o.load.rss_window_seconds / o.load.metrics_interval_seconds)));
+    if (const auto failure = RssGrowthFailure(*report.rss, *o.max_rss_growth, min_samples)) {
+      fmt::print(stderr, "load: {}\n", *failure);
+      failed = true;
+    }
+  }
+  if (failed) throw CLI::RuntimeError(1);
 }
 
 }  // namespace
@@ -61,8 +77,20 @@ void AddLoadCommand(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--unit", o->unit, "Unit sent with the clouds (default: the server's cell unit)")
       ->check(CLI::IsMember({"m", "mm"}));
-  cmd->add_option("--rpc", o->rpc, "RPC to call")
-      ->check(CLI::IsMember({"plan", "model", "plan-stream"}))
+  cmd->add_option("--rpc", o->rpc,
+                  "RPC to call: plan, model or plan-stream; a comma list (plan,plan-stream) is a fixed mix, "
+                  "the threads shared out evenly (--concurrency a multiple of its length)")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            try {
+              ParseLoadRpcs(value);
+            } catch (const InvalidArgument& e) {
+              const std::string what = e.what();  // CLI11 names the option itself
+              return what.rfind("--rpc: ", 0) == 0 ? what.substr(7) : what;
+            }
+            return {};
+          },
+          "RPC[,RPC...]"))
       ->capture_default_str();
   cmd->add_option("-c,--concurrency", o->load.concurrency, "Calls in flight at once (one thread each)")
       ->check(CLI::Range(1, 1024))
@@ -89,11 +117,21 @@ void AddLoadCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--fail-on-error", o->fail_on_error, "Exit 1 when any measured call failed (smoke tests)");
   cmd->add_option("--json", o->json_path, "Also write the report as JSON to this file");
-  cmd->add_option("--metrics-url", o->load.metrics_url,
-                  "Server's Prometheus endpoint (http://HOST:PORT/metrics): sample its RSS during the run");
+  auto* metrics_url = cmd->add_option(
+      "--metrics-url", o->load.metrics_url,
+      "Server's Prometheus endpoint (http://HOST:PORT/metrics): sample its RSS during the run");
   cmd->add_option("--metrics-interval", o->load.metrics_interval_seconds, "RSS sampling period, seconds")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--rss-window", o->load.rss_window_seconds,
+                  "Length of the first and last windows of the run whose RSS samples are compared, seconds")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--max-rss-growth", o->max_rss_growth,
+                  "Exit 1 when the mean RSS of the last window exceeds that of the first by more than this, "
+                  "percent (needs --metrics-url)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(metrics_url);
   cmd->add_option("--connect-timeout", o->load.connect_timeout_seconds,
                   "Give up connecting after this, seconds")
       ->check(CLI::PositiveNumber)

@@ -64,12 +64,12 @@ grpc::ByteBuffer Serialize(const google::protobuf::Message& message) {
   return grpc::ByteBuffer(&slice, 1);
 }
 
-PreparedCall Prepare(const LoadOptions& o, const LoadCloud& cloud) {
+PreparedCall Prepare(const LoadOptions& o, LoadRpc rpc, const LoadCloud& cloud) {
   PreparedCall call;
   v1::PointCloud* pc = nullptr;
   v1::ModelTubesRequest model;
   v1::PlanPickRequest plan;
-  if (o.rpc == LoadRpc::kModelTubes) {
+  if (rpc == LoadRpc::kModelTubes) {
     *model.mutable_options() = MakePlanningOptions(o);
     pc = model.mutable_cloud();
   } else {
@@ -77,7 +77,7 @@ PreparedCall Prepare(const LoadOptions& o, const LoadCloud& cloud) {
     pc = plan.mutable_cloud();
   }
   pc->set_unit(cloud.unit);
-  switch (o.rpc) {
+  switch (rpc) {
     case LoadRpc::kModelTubes:
       pc->set_xyz(cloud.xyz);
       call.unary = Serialize(model);
@@ -96,6 +96,8 @@ PreparedCall Prepare(const LoadOptions& o, const LoadCloud& cloud) {
 
 /// One finished call.
 struct CallRecord {
+  /// Index into LoadOptions::rpcs.
+  std::size_t rpc = 0;
   double seconds = 0.0;
   grpc::StatusCode code = grpc::StatusCode::OK;
   std::string message;
@@ -105,21 +107,23 @@ struct CallRecord {
 class Caller {
  public:
   Caller(std::shared_ptr<grpc::Channel> channel, const LoadOptions& options)
-      : options_(options),
-        method_(MethodName(options.rpc)),
-        generic_(channel),
-        stub_(v1::PickPlannerService::NewStub(channel)) {}
+      : options_(options), generic_(channel), stub_(v1::PickPlannerService::NewStub(channel)) {
+    for (const LoadRpc rpc : options.rpcs) methods_.push_back(MethodName(rpc));
+  }
 
-  CallRecord Call(const PreparedCall& call) const {
+  /// Calls options.rpcs[rpc] with `call` (prepared for that RPC).
+  CallRecord Call(std::size_t rpc, const PreparedCall& call) const {
     grpc::ClientContext context;
     if (options_.deadline_seconds > 0.0)
       context.set_deadline(std::chrono::system_clock::now() +
                            std::chrono::duration_cast<std::chrono::system_clock::duration>(
                                std::chrono::duration<double>(options_.deadline_seconds)));
     const Clock::time_point t0 = Clock::now();
-    const grpc::Status status =
-        options_.rpc == LoadRpc::kPlanPickStream ? Stream(&context, call) : Unary(&context, call);
+    const grpc::Status status = options_.rpcs[rpc] == LoadRpc::kPlanPickStream
+                                    ? Stream(&context, call)
+                                    : Unary(&context, methods_[rpc], call);
     CallRecord record;
+    record.rpc = rpc;
     record.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     record.code = status.error_code();
     record.message = status.error_message();
@@ -127,11 +131,12 @@ class Caller {
   }
 
  private:
-  grpc::Status Unary(grpc::ClientContext* context, const PreparedCall& call) const {
+  grpc::Status Unary(grpc::ClientContext* context, const std::string& method,
+                     const PreparedCall& call) const {
     grpc::ByteBuffer response;
     std::promise<grpc::Status> done;
     std::future<grpc::Status> result = done.get_future();
-    generic_.UnaryCall(context, method_, grpc::StubOptions(), &call.unary, &response,
+    generic_.UnaryCall(context, method, grpc::StubOptions(), &call.unary, &response,
                        [&done](grpc::Status status) { done.set_value(std::move(status)); });
     return result.get();
   }
@@ -148,28 +153,30 @@ class Caller {
   }
 
   const LoadOptions& options_;
-  const std::string method_;
+  std::vector<std::string> methods_;
   mutable grpc::GenericStub generic_;
   std::unique_ptr<v1::PickPlannerService::Stub> stub_;
 };
 
 /// Runs calls from `concurrency` threads until `count` calls started (count > 0) or `end` passed.
-/// `next` is the global round-robin position, shared across phases.
-std::vector<CallRecord> RunPhase(const Caller& caller, const std::vector<PreparedCall>& calls,
+/// calls[k][c] is cloud c prepared for options.rpcs[k]; thread w calls RPC k = w % calls.size() only,
+/// and next[k] is that RPC's round-robin position over the clouds, shared across phases.
+std::vector<CallRecord> RunPhase(const Caller& caller, const std::vector<std::vector<PreparedCall>>& calls,
                                  std::uint32_t concurrency, std::uint64_t count,
-                                 std::optional<Clock::time_point> end, std::atomic<std::uint64_t>& next) {
+                                 std::optional<Clock::time_point> end,
+                                 std::vector<std::atomic<std::uint64_t>>& next) {
   std::atomic<std::uint64_t> started{0};
   std::mutex mutex;
   std::vector<CallRecord> records;
   std::vector<std::thread> workers;
   for (std::uint32_t w = 0; w < concurrency; ++w) {
-    workers.emplace_back([&] {
+    workers.emplace_back([&, rpc = w % calls.size()] {
+      const std::vector<PreparedCall>& clouds = calls[rpc];
       std::vector<CallRecord> mine;
       for (;;) {
         if (count > 0 && started.fetch_add(1) >= count) break;
         if (end && Clock::now() >= *end) break;
-        const std::uint64_t i = next.fetch_add(1);
-        mine.push_back(caller.Call(calls[i % calls.size()]));
+        mine.push_back(caller.Call(rpc, clouds[next[rpc].fetch_add(1) % clouds.size()]));
       }
       std::lock_guard lock(mutex);
       records.insert(records.end(), std::make_move_iterator(mine.begin()),
@@ -206,6 +213,24 @@ LoadRpc ParseLoadRpc(const std::string& name) {
   if (name == "model") return LoadRpc::kModelTubes;
   if (name == "plan-stream") return LoadRpc::kPlanPickStream;
   throw InvalidArgument("--rpc: '" + name + "' is not plan, model or plan-stream");
+}
+
+std::vector<LoadRpc> ParseLoadRpcs(const std::string& names) {
+  std::vector<LoadRpc> rpcs;
+  std::size_t begin = 0;
+  for (;;) {
+    const std::size_t comma = names.find(',', begin);
+    rpcs.push_back(ParseLoadRpc(names.substr(begin, comma == std::string::npos ? comma : comma - begin)));
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  return rpcs;
+}
+
+std::string ToString(const std::vector<LoadRpc>& rpcs) {
+  std::string out;
+  for (const LoadRpc rpc : rpcs) out += (out.empty() ? "" : ",") + ToString(rpc);
+  return out;
 }
 
 std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUnit unit) {
@@ -255,16 +280,22 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   if (o.concurrency == 0) throw InvalidArgument("--concurrency: must be at least 1");
   if (o.total == 0 && !(o.duration_seconds > 0.0))
     throw InvalidArgument("--total or --duration: give a positive call count or duration");
-  if (o.rpc == LoadRpc::kPlanPickStream && o.chunk_bytes == 0)
+  if (o.rpcs.empty()) throw InvalidArgument("--rpc: no RPC to call");
+  if (o.concurrency % o.rpcs.size() != 0)
+    throw InvalidArgument(
+        fmt::format("--concurrency: {} is not a multiple of the {} RPCs of --rpc {} (each gets "
+                    "the same number of threads)",
+                    o.concurrency, o.rpcs.size(), ToString(o.rpcs)));
+  if (std::find(o.rpcs.begin(), o.rpcs.end(), LoadRpc::kPlanPickStream) != o.rpcs.end() && o.chunk_bytes == 0)
     throw InvalidArgument("chunk size: must be positive");
 
-  std::vector<PreparedCall> calls;
-  calls.reserve(clouds.size());
-  double cloud_bytes = 0.0;
-  for (const LoadCloud& c : clouds) {
-    calls.push_back(Prepare(o, c));
-    cloud_bytes += static_cast<double>(c.xyz.size());
+  std::vector<std::vector<PreparedCall>> calls(o.rpcs.size());
+  for (std::size_t k = 0; k < o.rpcs.size(); ++k) {
+    calls[k].reserve(clouds.size());
+    for (const LoadCloud& c : clouds) calls[k].push_back(Prepare(o, o.rpcs[k], c));
   }
+  double cloud_bytes = 0.0;
+  for (const LoadCloud& c : clouds) cloud_bytes += static_cast<double>(c.xyz.size());
 
   std::shared_ptr<grpc::Channel> channel = MakeChannel(o.channel);
   const auto connect_deadline =
@@ -275,7 +306,7 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
                                       o.connect_timeout_seconds));
   const Caller caller(channel, o);
 
-  std::atomic<std::uint64_t> next{0};
+  std::vector<std::atomic<std::uint64_t>> next(o.rpcs.size());
   if (o.warmup > 0) RunPhase(caller, calls, o.concurrency, o.warmup, std::nullopt, next);
 
   std::optional<RssSampler> sampler;
@@ -290,8 +321,13 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
 
   LoadReport report;
-  report.rpc = ToString(o.rpc);
-  report.method = MethodName(o.rpc).substr(1);
+  report.rpc = ToString(o.rpcs);
+  for (const LoadRpc rpc : o.rpcs) {
+    report.method += (report.method.empty() ? "" : ", ") + MethodName(rpc).substr(1);
+    RpcReport& by = report.by_rpc.emplace_back();
+    by.rpc = ToString(rpc);
+    by.method = MethodName(rpc).substr(1);
+  }
   report.target = o.channel.target;
   report.concurrency = o.concurrency;
   report.clouds = clouds.size();
@@ -300,14 +336,23 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   report.total = records.size();
   report.elapsed_seconds = elapsed;
   std::vector<double> ok_seconds;
+  std::vector<std::vector<double>> ok_seconds_by_rpc(o.rpcs.size());
   for (const CallRecord& r : records) {
     const std::string code = StatusCodeName(r.code);
     ++report.status_counts[code];
+    RpcReport& by = report.by_rpc[r.rpc];
+    ++by.total;
+    ++by.status_counts[code];
     if (r.code == grpc::StatusCode::OK) {
       ok_seconds.push_back(r.seconds);
+      ok_seconds_by_rpc[r.rpc].push_back(r.seconds);
     } else if (!report.error_examples.contains(code)) {
       report.error_examples[code] = r.message;
     }
+  }
+  for (std::size_t k = 0; k < o.rpcs.size(); ++k) {
+    report.by_rpc[k].ok = ok_seconds_by_rpc[k].size();
+    report.by_rpc[k].latency = SummarizeLatency(std::move(ok_seconds_by_rpc[k]));
   }
   report.ok = ok_seconds.size();
   if (elapsed > 0.0) {
@@ -315,7 +360,9 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
     report.ok_per_second = static_cast<double>(report.ok) / elapsed;
   }
   report.latency = SummarizeLatency(std::move(ok_seconds));
-  if (sampler) report.rss = sampler->Stop();
+  if (sampler)
+    report.rss = sampler->Stop(o.rss_window_seconds,
+                               o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt);
   return report;
 }
 
@@ -343,6 +390,13 @@ std::string FormatLoadReportText(const LoadReport& r) {
   } else {
     line("Latency: no successful call");
   }
+  if (r.by_rpc.size() > 1) {
+    line("");
+    line("By RPC (latency of successful calls, s):");
+    for (const RpcReport& b : r.by_rpc)
+      line(fmt::format("  {:<12} {:>6} calls ({} OK)  p50 {:.4f}  p95 {:.4f}  max {:.4f}", b.rpc, b.total,
+                       b.ok, b.latency.p50, b.latency.p95, b.latency.max));
+  }
   line("");
   line("Status code distribution:");
   for (const auto& [code, count] : r.status_counts) {
@@ -354,8 +408,8 @@ std::string FormatLoadReportText(const LoadReport& r) {
   if (r.rss) {
     const RssSummary& m = *r.rss;
     line("");
-    line(fmt::format("Server RSS (process_resident_memory_bytes from {}, every {:.1f} s, {} samples{}):",
-                     m.url, m.interval_seconds, m.samples.size(),
+    line(fmt::format("Server RSS (process_resident_memory_bytes from {}, every {:g} s, {} samples{}):", m.url,
+                     m.interval_seconds, m.samples.size(),
                      m.failed_scrapes ? fmt::format(", {} failed scrapes", m.failed_scrapes) : ""));
     if (m.samples.empty()) {
       line("  no sample");
@@ -364,6 +418,13 @@ std::string FormatLoadReportText(const LoadReport& r) {
                        HumanBytes(static_cast<double>(m.first_window_max)), m.window_seconds,
                        HumanBytes(static_cast<double>(m.last_window_max)), m.growth_percent,
                        HumanBytes(static_cast<double>(m.peak))));
+      line(fmt::format("  first {:.0f} s mean {}, last {:.0f} s mean {} ({:+.1f} %); {} and {} samples",
+                       m.window_seconds, HumanBytes(m.first_window_mean), m.window_seconds,
+                       HumanBytes(m.last_window_mean), m.mean_growth_percent, m.first_window_samples,
+                       m.last_window_samples));
+      line(fmt::format("  first {:.0f} s median {}, last {:.0f} s median {} ({:+.1f} %)", m.window_seconds,
+                       HumanBytes(static_cast<double>(m.first_window_median)), m.window_seconds,
+                       HumanBytes(static_cast<double>(m.last_window_median)), m.median_growth_percent));
     }
   }
   return out;
@@ -388,6 +449,24 @@ std::string FormatLoadReportJson(const LoadReport& r) {
                           {"p95", l.p95}, {"p99", l.p99},   {"max", l.max}};
   j["status_counts"] = r.status_counts;
   j["error_examples"] = r.error_examples;
+  nlohmann::json by_rpc = nlohmann::json::array();
+  for (const RpcReport& b : r.by_rpc) {
+    const LatencySummary& bl = b.latency;
+    by_rpc.push_back({{"rpc", b.rpc},
+                      {"method", b.method},
+                      {"count", b.total},
+                      {"ok", b.ok},
+                      {"status_counts", b.status_counts},
+                      {"latency_seconds",
+                       {{"min", bl.min},
+                        {"mean", bl.mean},
+                        {"p50", bl.p50},
+                        {"p90", bl.p90},
+                        {"p95", bl.p95},
+                        {"p99", bl.p99},
+                        {"max", bl.max}}}});
+  }
+  j["by_rpc"] = by_rpc;
   if (r.rss) {
     const RssSummary& m = *r.rss;
     nlohmann::json samples = nlohmann::json::array();
@@ -399,6 +478,15 @@ std::string FormatLoadReportJson(const LoadReport& r) {
                        {"last_window_max_bytes", m.last_window_max},
                        {"peak_bytes", m.peak},
                        {"growth_percent", m.growth_percent},
+                       {"end_seconds", m.end_seconds},
+                       {"first_window_samples", m.first_window_samples},
+                       {"last_window_samples", m.last_window_samples},
+                       {"first_window_mean_bytes", m.first_window_mean},
+                       {"last_window_mean_bytes", m.last_window_mean},
+                       {"mean_growth_percent", m.mean_growth_percent},
+                       {"first_window_median_bytes", m.first_window_median},
+                       {"last_window_median_bytes", m.last_window_median},
+                       {"median_growth_percent", m.median_growth_percent},
                        {"failed_scrapes", m.failed_scrapes},
                        {"samples", samples}};
   }

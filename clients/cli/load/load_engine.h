@@ -20,6 +20,11 @@ enum class LoadRpc { kPlanPick, kModelTubes, kPlanPickStream };
 std::string ToString(LoadRpc rpc);
 /// @throws InvalidArgument naming --rpc for anything else.
 LoadRpc ParseLoadRpc(const std::string& name);
+/// A comma-separated list of --rpc names ("plan,plan-stream"), in order; repeats allowed.
+/// @throws InvalidArgument naming --rpc for an empty list or an unknown name.
+std::vector<LoadRpc> ParseLoadRpcs(const std::string& names);
+/// The names joined by commas, as ParseLoadRpcs reads them.
+std::string ToString(const std::vector<LoadRpc>& rpcs);
 
 /// One recorded cloud, already packed for the wire.
 struct LoadCloud {
@@ -40,7 +45,10 @@ std::vector<LoadCloud> ReadLoadClouds(const std::string& directory, v1::LengthUn
 /// What to send, how often and how many at once.
 struct LoadOptions {
   ChannelOptions channel;
-  LoadRpc rpc = LoadRpc::kPlanPick;
+  /// RPCs to call. Several make a fixed mix: thread w (of `concurrency`, which must be a multiple of
+  /// rpcs.size()) calls rpcs[w % n] only, so the same number of calls of each RPC is always in flight;
+  /// each RPC goes round-robin over the clouds.
+  std::vector<LoadRpc> rpcs{LoadRpc::kPlanPick};
   /// Calls in flight at once: one worker thread each, all on one channel.
   std::uint32_t concurrency = 1;
   /// Measured calls; 0 = run for duration_seconds instead.
@@ -62,6 +70,8 @@ struct LoadOptions {
   /// Prometheus endpoint of the server (http://HOST:PORT/metrics); empty = no RSS sampling.
   std::string metrics_url;
   double metrics_interval_seconds = 5.0;
+  /// Length of the first and last windows the RSS samples are compared over, seconds.
+  double rss_window_seconds = 60.0;
   /// How long to wait for the channel to connect before giving up, seconds.
   double connect_timeout_seconds = 10.0;
 };
@@ -80,10 +90,20 @@ struct LatencySummary {
 /// Nearest-rank percentiles of `seconds` (any order). Empty input gives all zeros.
 LatencySummary SummarizeLatency(std::vector<double> seconds);
 
-/// The outcome of one load run (measured phase only), like ghz's summary.
-struct LoadReport {
+/// The calls of one RPC in a run that mixes several.
+struct RpcReport {
   std::string rpc;     ///< "plan", "model", "plan-stream"
   std::string method;  ///< full gRPC method name
+  std::uint64_t total = 0;
+  std::uint64_t ok = 0;
+  std::map<std::string, std::uint64_t> status_counts;
+  LatencySummary latency;
+};
+
+/// The outcome of one load run (measured phase only), like ghz's summary.
+struct LoadReport {
+  std::string rpc;     ///< "plan", "model", "plan-stream"; several joined by commas
+  std::string method;  ///< full gRPC method name; several joined by ", "
   std::string target;
   std::uint32_t concurrency = 0;
   std::uint64_t clouds = 0;
@@ -103,6 +123,8 @@ struct LoadReport {
   double requests_per_second = 0.0;
   double ok_per_second = 0.0;
   LatencySummary latency;
+  /// The same per RPC, in the order of LoadOptions::rpcs (one entry for a single RPC).
+  std::vector<RpcReport> by_rpc;
   /// Present when metrics_url was given.
   std::optional<RssSummary> rss;
 };
@@ -110,8 +132,9 @@ struct LoadReport {
 /// Runs the load: connects, optionally warms up, then sends the clouds round-robin from
 /// `concurrency` threads (each with one call in flight) until `total` calls completed or
 /// `duration_seconds` passed. Call failures are counted by status code, never thrown.
-/// @throws InvalidArgument for inconsistent options (no clouds, concurrency 0, neither total nor
-///         duration) or when the target does not connect within connect_timeout_seconds.
+/// @throws InvalidArgument for inconsistent options (no clouds, concurrency 0 or not a multiple of the
+///         number of RPCs, neither total nor duration) or when the target does not connect within
+///         connect_timeout_seconds.
 LoadReport RunLoad(const LoadOptions& options, const std::vector<LoadCloud>& clouds);
 
 /// ghz-like text summary (several lines, ends with a newline).

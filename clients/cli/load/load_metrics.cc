@@ -84,23 +84,74 @@ std::optional<double> PrometheusSample(std::string_view text, std::string_view n
   return std::nullopt;
 }
 
-RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds) {
+RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
+                        std::optional<double> end_seconds) {
   RssSummary s;
   s.window_seconds = window_seconds;
   s.samples = std::move(samples);
-  if (s.samples.empty()) return s;
-  const double end = s.samples.back().seconds;
+  if (s.samples.empty()) {
+    s.end_seconds = end_seconds.value_or(0.0);
+    return s;
+  }
+  const double begin = s.samples.front().seconds;
+  const double end = end_seconds.value_or(s.samples.back().seconds);
+  s.end_seconds = end;
+  std::vector<std::uint64_t> first;
+  std::vector<std::uint64_t> last;
   for (const RssSample& r : s.samples) {
     s.peak = std::max(s.peak, r.bytes);
-    if (r.seconds <= s.samples.front().seconds + window_seconds)
-      s.first_window_max = std::max(s.first_window_max, r.bytes);
-    if (r.seconds >= end - window_seconds) s.last_window_max = std::max(s.last_window_max, r.bytes);
+    if (r.seconds <= begin + window_seconds) first.push_back(r.bytes);
+    if (r.seconds >= end - window_seconds && r.seconds <= end) last.push_back(r.bytes);
   }
-  if (s.first_window_max > 0)
-    s.growth_percent = 100.0 *
-                       (static_cast<double>(s.last_window_max) - static_cast<double>(s.first_window_max)) /
-                       static_cast<double>(s.first_window_max);
+  const auto percent = [](std::uint64_t from, std::uint64_t to) {
+    return from == 0
+               ? 0.0
+               : 100.0 * (static_cast<double>(to) - static_cast<double>(from)) / static_cast<double>(from);
+  };
+  const auto median = [](std::vector<std::uint64_t>& v) -> std::uint64_t {
+    if (v.empty()) return 0;
+    // Nearest rank: the ceil(n / 2)-th smallest.
+    const std::size_t rank = (v.size() + 1) / 2 - 1;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rank), v.end());
+    return v[rank];
+  };
+  const auto mean = [](const std::vector<std::uint64_t>& v) {
+    double sum = 0.0;
+    for (const std::uint64_t b : v) sum += static_cast<double>(b);
+    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+  };
+  s.first_window_mean = mean(first);
+  s.last_window_mean = mean(last);
+  if (s.first_window_mean > 0.0)
+    s.mean_growth_percent = 100.0 * (s.last_window_mean - s.first_window_mean) / s.first_window_mean;
+  if (!first.empty()) s.first_window_max = *std::max_element(first.begin(), first.end());
+  if (!last.empty()) s.last_window_max = *std::max_element(last.begin(), last.end());
+  s.first_window_samples = first.size();
+  s.last_window_samples = last.size();
+  s.first_window_median = median(first);
+  s.last_window_median = median(last);
+  s.growth_percent = percent(s.first_window_max, s.last_window_max);
+  s.median_growth_percent = percent(s.first_window_median, s.last_window_median);
   return s;
+}
+
+std::optional<std::string> RssGrowthFailure(const RssSummary& s, double max_growth_percent,
+                                            std::size_t min_window_samples) {
+  if (s.first_window_samples < min_window_samples || s.last_window_samples < min_window_samples)
+    return fmt::format(
+        "too few RSS samples to judge: {} in the first {:.0f} s, {} in the last, at least {} needed ({} "
+        "failed "
+        "scrapes)",
+        s.first_window_samples, s.window_seconds, s.last_window_samples, min_window_samples,
+        s.failed_scrapes);
+  if (s.mean_growth_percent > max_growth_percent)
+    return fmt::format(
+        "server RSS grew {:+.1f} % (mean of the last {:.0f} s {:.1f} MB against {:.1f} MB in the first "
+        "{:.0f} s), "
+        "more than the {:.1f} % allowed",
+        s.mean_growth_percent, s.window_seconds, s.last_window_mean / 1e6, s.first_window_mean / 1e6,
+        s.window_seconds, max_growth_percent);
+  return std::nullopt;
 }
 
 RssSampler::RssSampler(std::string url, std::chrono::milliseconds interval)
@@ -137,7 +188,7 @@ void RssSampler::Loop() {
   }
 }
 
-RssSummary RssSampler::Stop() {
+RssSummary RssSampler::Stop(double window_seconds, std::optional<double> end_seconds) {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
@@ -146,7 +197,7 @@ RssSummary RssSampler::Stop() {
   if (thread_.joinable()) thread_.join();
   SampleOnce();
   std::lock_guard lock(mutex_);
-  RssSummary summary = SummarizeRss(samples_, 60.0);
+  RssSummary summary = SummarizeRss(samples_, window_seconds, end_seconds);
   summary.url = url_;
   summary.interval_seconds = std::chrono::duration<double>(interval_).count();
   summary.failed_scrapes = failed_;

@@ -37,18 +37,47 @@ struct RssSummary {
   std::vector<RssSample> samples;
   /// Scrapes that failed (connection refused, no process_resident_memory_bytes, ...).
   std::uint64_t failed_scrapes = 0;
-  /// Window length of the first and last comparison windows, seconds (60).
+  /// Length of the first and last comparison windows, seconds.
   double window_seconds = 60.0;
-  /// Highest RSS in [0, window] and in [end − window, end], and over the whole run, bytes.
+  /// Where the last window ends, seconds: the end of a --duration run's measured phase (samples taken
+  /// while its last calls drain fall in no window), else the last sample.
+  double end_seconds = 0.0;
+  /// Highest RSS in the first window [t0, t0 + window] (t0 = the first sample) and in the last
+  /// [end − window, end], and over all samples, bytes.
   std::uint64_t first_window_max = 0;
   std::uint64_t last_window_max = 0;
   std::uint64_t peak = 0;
   /// (last_window_max − first_window_max) / first_window_max, percent.
   double growth_percent = 0.0;
+  /// Samples in each window.
+  std::size_t first_window_samples = 0;
+  std::size_t last_window_samples = 0;
+  /// Mean of each window's samples, bytes: with evenly spaced samples, the time-averaged RSS. This is
+  /// the figure the memory check compares. The server's RSS follows its calls in flight (it hands
+  /// a call's memory back when the call ends), swinging by 100+ MB within a second; the time average
+  /// adds up each call's memory whether or not concurrent calls happen to peak together, whereas a
+  /// window's maximum hangs on one scrape and its median on how the calls' phases line up.
+  double first_window_mean = 0.0;
+  double last_window_mean = 0.0;
+  /// (last_window_mean − first_window_mean) / first_window_mean, percent.
+  double mean_growth_percent = 0.0;
+  /// Medians of each window (nearest rank: the smallest sample with at least half of the window's
+  /// samples at or below it), bytes, and their change, percent. Reported, not judged.
+  std::uint64_t first_window_median = 0;
+  std::uint64_t last_window_median = 0;
+  double median_growth_percent = 0.0;
 };
 
-/// Summarises samples (sorted by time) over windows of `window_seconds`.
-RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds);
+/// Summarises samples (sorted by time) over windows of `window_seconds`; the last window ends at
+/// `end_seconds` when given, else at the last sample.
+RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
+                        std::optional<double> end_seconds = std::nullopt);
+
+/// Why a run fails the memory check, or std::nullopt when it passes: fails when either window holds
+/// fewer than `min_window_samples` samples, or when the mean RSS of the last window is more than
+/// `max_growth_percent` above the mean of the first. A fall is no failure (memory handed back).
+std::optional<std::string> RssGrowthFailure(const RssSummary& summary, double max_growth_percent,
+                                            std::size_t min_window_samples);
 
 /// Scrapes process_resident_memory_bytes from a Prometheus endpoint every `interval` on its own
 /// thread, from construction until Stop().
@@ -59,8 +88,8 @@ class RssSampler {
   RssSampler(const RssSampler&) = delete;
   RssSampler& operator=(const RssSampler&) = delete;
 
-  /// Takes a last sample, stops the thread and summarises (60 s windows). Call once.
-  RssSummary Stop();
+  /// Takes a last sample, stops the thread and summarises (see SummarizeRss). Call once.
+  RssSummary Stop(double window_seconds = 60.0, std::optional<double> end_seconds = std::nullopt);
 
  private:
   void Loop();

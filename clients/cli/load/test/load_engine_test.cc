@@ -64,5 +64,18 @@ TEST(LoadEngine, RpcNamesRoundTrip) {
   EXPECT_THROW(ParseLoadRpc("planpick"), InvalidArgument);
 }
 
+TEST(LoadEngine, RpcListsParseInOrder) {
+  const std::vector<LoadRpc> mixed = ParseLoadRpcs("plan,plan-stream");
+  ASSERT_EQ(mixed.size(), 2u);
+  EXPECT_EQ(mixed[0], LoadRpc::kPlanPick);
+  EXPECT_EQ(mixed[1], LoadRpc::kPlanPickStream);
+  EXPECT_EQ(ToString(mixed), "plan,plan-stream");
+  EXPECT_EQ(ParseLoadRpcs("model"), std::vector<LoadRpc>{LoadRpc::kModelTubes});
+  EXPECT_EQ(ParseLoadRpcs("plan,plan").size(), 2u);
+  EXPECT_THROW(ParseLoadRpcs(""), InvalidArgument);
+  EXPECT_THROW(ParseLoadRpcs("plan,"), InvalidArgument);
+  EXPECT_THROW(ParseLoadRpcs("plan,planpick"), InvalidArgument);
+}
+
 }  // namespace
 }  // namespace tubepick::cli

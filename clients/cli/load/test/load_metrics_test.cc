@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -37,6 +38,75 @@ TEST(LoadMetrics, SummarizeRssComparesFirstAndLastMinute) {
   EXPECT_EQ(s.last_window_max, 105'000'000u);
   EXPECT_EQ(s.peak, 120'000'000u);
   EXPECT_NEAR(s.growth_percent, 5.0, 1e-9);
+}
+
+TEST(LoadMetrics, SummarizeRssOverWindowsEndingAtTheMeasuredPhase) {
+  // 120 s measured, a sample every second, then 3 s of draining calls. RSS follows the calls in
+  // flight: it alternates 100 / 200 / 150 MB in the first 30 s and 110 / 210 / 160 MB in the last 30 s
+  // (medians 150 and 160 MB), with one spike of 900 MB in each window that the maximum follows.
+  std::vector<RssSample> samples;
+  for (int t = 0; t <= 123; ++t) {
+    const std::uint64_t base = t < 60 ? 100 : 110;
+    std::uint64_t mb = base + (t % 3 == 1 ? 100 : (t % 3 == 2 ? 50 : 0));
+    if (t == 10 || t == 100) mb = 900;
+    if (t > 120) mb = 5000;  // draining: outside every window
+    samples.push_back({static_cast<double>(t), mb * 1'000'000});
+  }
+  const RssSummary s = SummarizeRss(samples, 30.0, 120.0);
+  EXPECT_EQ(s.end_seconds, 120.0);
+  EXPECT_EQ(s.first_window_samples, 31u);  // t = 0 .. 30
+  EXPECT_EQ(s.last_window_samples, 31u);   // t = 90 .. 120
+  EXPECT_EQ(s.first_window_median, 150'000'000u);
+  EXPECT_EQ(s.last_window_median, 160'000'000u);
+  EXPECT_NEAR(s.median_growth_percent, 100.0 * 10.0 / 150.0, 1e-9);
+  // Means (the judged figure): 11 × 100 + 9 × 200 + 900 + 10 × 150 = 5300 MB over 31 samples, and
+  // 11 × 110 + 9 × 210 + 900 + 10 × 160 = 5600 MB.
+  EXPECT_NEAR(s.first_window_mean, 5300e6 / 31.0, 1e-3);
+  EXPECT_NEAR(s.last_window_mean, 5600e6 / 31.0, 1e-3);
+  EXPECT_NEAR(s.mean_growth_percent, 100.0 * 300.0 / 5300.0, 1e-9);
+  EXPECT_EQ(s.first_window_max, 900'000'000u);
+  EXPECT_EQ(s.last_window_max, 900'000'000u);
+  EXPECT_EQ(s.peak, 5'000'000'000u);
+  EXPECT_FALSE(RssGrowthFailure(s, 10.0, 15).has_value());
+
+  // Without an end the last window ends at the last sample and takes in the drain.
+  const RssSummary to_last = SummarizeRss(samples, 30.0);
+  EXPECT_EQ(to_last.end_seconds, 123.0);
+  EXPECT_EQ(to_last.last_window_max, 5'000'000'000u);
+}
+
+TEST(LoadMetrics, MedianIsTheNearestRank) {
+  // Four samples in the window: the nearest-rank median is the 2nd smallest.
+  const RssSummary s = SummarizeRss({{0, 40}, {1, 10}, {2, 30}, {3, 20}}, 10.0);
+  EXPECT_EQ(s.first_window_median, 20u);
+  EXPECT_EQ(s.first_window_mean, 25.0);
+  EXPECT_EQ(s.last_window_median, 20u);
+  EXPECT_EQ(s.median_growth_percent, 0.0);
+  EXPECT_EQ(SummarizeRss({}, 30.0, 120.0).first_window_median, 0u);
+}
+
+TEST(LoadMetrics, RssGrowthFailureNamesTheReason) {
+  std::vector<RssSample> samples;
+  for (int t = 0; t <= 60; ++t)
+    samples.push_back({static_cast<double>(t), t < 30 ? 100'000'000u : 112'000'000u});
+  const RssSummary grew = SummarizeRss(samples, 20.0, 60.0);
+  EXPECT_NEAR(grew.mean_growth_percent, 12.0, 1e-9);
+  const std::optional<std::string> failure = RssGrowthFailure(grew, 10.0, 10);
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_NE(failure->find("+12.0 %"), std::string::npos) << *failure;
+  EXPECT_NE(failure->find("10.0 % allowed"), std::string::npos) << *failure;
+  EXPECT_FALSE(RssGrowthFailure(grew, 12.5, 10).has_value());
+
+  // A fall is memory handed back, not a failure.
+  std::reverse(samples.begin(), samples.end());
+  for (int t = 0; t <= 60; ++t) samples[t].seconds = t;
+  EXPECT_FALSE(RssGrowthFailure(SummarizeRss(samples, 20.0, 60.0), 10.0, 10).has_value());
+
+  // Too few samples to judge (the endpoint stopped answering).
+  const std::optional<std::string> sparse =
+      RssGrowthFailure(SummarizeRss({{0, 1}, {60, 1}}, 20.0, 60.0), 10.0, 10);
+  ASSERT_TRUE(sparse.has_value());
+  EXPECT_NE(sparse->find("too few RSS samples"), std::string::npos) << *sparse;
 }
 
 TEST(LoadMetrics, HttpGetOfAClosedPortThrows) {
