@@ -158,25 +158,59 @@ class Caller {
   std::unique_ptr<v1::PickPlannerService::Stub> stub_;
 };
 
-/// Runs calls from `concurrency` threads until `count` calls started (count > 0) or `end` passed.
-/// calls[k][c] is cloud c prepared for options.rpcs[k]; thread w calls RPC k = w % calls.size() only,
-/// and next[k] is that RPC's round-robin position over the clouds, shared across phases.
-std::vector<CallRecord> RunPhase(const Caller& caller, const std::vector<std::vector<PreparedCall>>& calls,
-                                 std::uint32_t concurrency, std::uint64_t count,
-                                 std::optional<Clock::time_point> end,
-                                 std::vector<std::atomic<std::uint64_t>>& next) {
+/// The measured phase: it starts once, when the warm-up's last call completes (at once without a
+/// warm-up), while the other threads' calls go on, so it begins with the server in its steady state
+/// rather than idle. Written before `started` is set, read after seeing it.
+struct MeasuredPhase {
+  std::once_flag once;
+  std::atomic<bool> started{false};
+  Clock::time_point t0;
+  std::optional<Clock::time_point> end;  ///< duration runs
+  std::optional<RssSampler> sampler;     ///< started with the phase
+};
+
+/// Runs the calls: `concurrency` threads, each with one call in flight, until o.total measured calls
+/// started or the measured phase's end passed. calls[k][c] is cloud c prepared for o.rpcs[k]; thread w
+/// calls RPC k = w % calls.size() only, and next[k] is that RPC's round-robin position over the
+/// clouds. A call that started before the measured phase is not counted, even when it ends after.
+/// Returns the measured calls.
+std::vector<CallRecord> RunCalls(const Caller& caller, const std::vector<std::vector<PreparedCall>>& calls,
+                                 const LoadOptions& o, MeasuredPhase& phase) {
+  std::vector<std::atomic<std::uint64_t>> next(calls.size());
+  std::atomic<std::uint64_t> warmed{0};
   std::atomic<std::uint64_t> started{0};
+  const auto begin = [&] {
+    std::call_once(phase.once, [&] {
+      phase.t0 = Clock::now();
+      if (o.total == 0)
+        phase.end = phase.t0 + std::chrono::duration_cast<Clock::duration>(
+                                   std::chrono::duration<double>(o.duration_seconds));
+      if (!o.metrics_url.empty())
+        phase.sampler.emplace(o.metrics_url, std::chrono::milliseconds(static_cast<long long>(
+                                                 std::max(0.1, o.metrics_interval_seconds) * 1000.0)));
+      phase.started.store(true, std::memory_order_release);
+    });
+  };
+  if (o.warmup == 0) begin();
   std::mutex mutex;
   std::vector<CallRecord> records;
   std::vector<std::thread> workers;
-  for (std::uint32_t w = 0; w < concurrency; ++w) {
+  for (std::uint32_t w = 0; w < o.concurrency; ++w) {
     workers.emplace_back([&, rpc = w % calls.size()] {
       const std::vector<PreparedCall>& clouds = calls[rpc];
       std::vector<CallRecord> mine;
       for (;;) {
-        if (count > 0 && started.fetch_add(1) >= count) break;
-        if (end && Clock::now() >= *end) break;
-        mine.push_back(caller.Call(rpc, clouds[next[rpc].fetch_add(1) % clouds.size()]));
+        const bool measured = phase.started.load(std::memory_order_acquire);
+        if (measured) {
+          if (o.total > 0 && started.fetch_add(1) >= o.total) break;
+          if (phase.end && Clock::now() >= *phase.end) break;
+        }
+        CallRecord record = caller.Call(rpc, clouds[next[rpc].fetch_add(1) % clouds.size()]);
+        if (measured) {
+          mine.push_back(std::move(record));
+        } else if (warmed.fetch_add(1) + 1 >= o.warmup) {
+          begin();
+        }
       }
       std::lock_guard lock(mutex);
       records.insert(records.end(), std::make_move_iterator(mine.begin()),
@@ -306,19 +340,9 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
                                       o.connect_timeout_seconds));
   const Caller caller(channel, o);
 
-  std::vector<std::atomic<std::uint64_t>> next(o.rpcs.size());
-  if (o.warmup > 0) RunPhase(caller, calls, o.concurrency, o.warmup, std::nullopt, next);
-
-  std::optional<RssSampler> sampler;
-  if (!o.metrics_url.empty())
-    sampler.emplace(o.metrics_url, std::chrono::milliseconds(static_cast<long long>(
-                                       std::max(0.1, o.metrics_interval_seconds) * 1000.0)));
-  const Clock::time_point t0 = Clock::now();
-  std::optional<Clock::time_point> end;
-  if (o.total == 0)
-    end = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.duration_seconds));
-  const std::vector<CallRecord> records = RunPhase(caller, calls, o.concurrency, o.total, end, next);
-  const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+  MeasuredPhase phase;
+  const std::vector<CallRecord> records = RunCalls(caller, calls, o, phase);
+  const double elapsed = std::chrono::duration<double>(Clock::now() - phase.t0).count();
 
   LoadReport report;
   report.rpc = ToString(o.rpcs);
@@ -360,9 +384,9 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
     report.ok_per_second = static_cast<double>(report.ok) / elapsed;
   }
   report.latency = SummarizeLatency(std::move(ok_seconds));
-  if (sampler)
-    report.rss = sampler->Stop(o.rss_window_seconds,
-                               o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt);
+  if (phase.sampler)
+    report.rss = phase.sampler->Stop(o.rss_window_seconds,
+                                     o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt);
   return report;
 }
 

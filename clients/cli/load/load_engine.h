@@ -56,7 +56,9 @@ struct LoadOptions {
   /// Measured phase length when total == 0, seconds: no call starts after it (calls in flight
   /// finish and count).
   double duration_seconds = 0.0;
-  /// Calls made before the measured phase (same concurrency), not counted.
+  /// Calls that complete before the measured phase (same concurrency), not counted. The phase starts
+  /// when the last of them completes, with the other threads' calls still in flight (those are not
+  /// counted either), so the server is in its steady state when measuring (and RSS sampling) begins.
   std::uint64_t warmup = 0;
   /// Deadline of each call, seconds; 0 = none.
   double deadline_seconds = 0.0;
