@@ -1,0 +1,30 @@
+# Sanitizer and fuzzing builds (deploy/ci/sanitizers.sh, deploy/ci/fuzz.sh).
+#
+#   -DTUBEPICK_SANITIZE=address,undefined   ASan + UBSan (the unit suites and the fuzz targets)
+#   -DTUBEPICK_SANITIZE=thread              TSan (the service tests)
+#   -DTUBEPICK_FUZZ=ON                      the libFuzzer targets in fuzz/ (clang only)
+#
+# Unlike warnings and the standard (per target, tubepick_set_options), instrumentation is a property
+# of the whole build tree: a target built without it would hide errors (ASan) or report false races
+# (TSan). So these are the only tree-wide flags, and only when asked for.
+set(TUBEPICK_SANITIZE "" CACHE STRING
+  "Sanitizers for every target of this build tree: address,undefined | thread | (empty: none)")
+option(TUBEPICK_FUZZ "Build the libFuzzer targets in fuzz/ (needs clang)" OFF)
+
+if(TUBEPICK_SANITIZE)
+  add_compile_options(-fsanitize=${TUBEPICK_SANITIZE} -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=${TUBEPICK_SANITIZE})
+  if(TUBEPICK_SANITIZE MATCHES "undefined")
+    # Any undefined behaviour fails the test or the fuzz run instead of printing and going on.
+    add_compile_options(-fno-sanitize-recover=undefined)
+  endif()
+endif()
+
+if(TUBEPICK_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "TUBEPICK_FUZZ needs clang (libFuzzer): -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  # Coverage feedback for libFuzzer in every library the fuzz targets link; only the fuzz
+  # executables themselves link the fuzzer's main (-fsanitize=fuzzer, fuzz/CMakeLists.txt).
+  add_compile_options(-fsanitize=fuzzer-no-link)
+endif()
