@@ -36,6 +36,9 @@ else
     libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
     libmodbus-dev libcurl4-openssl-dev libgtest-dev libgmock-dev libbenchmark-dev
     openssl curl
+    # deploy/ci/sanitizers.sh and fuzz.sh: clang with its sanitizer and libFuzzer runtimes, its
+    # OpenMP, and llvm-symbolizer for the stack traces.
+    clang libclang-rt-dev libomp-dev llvm
   )
 fi
 

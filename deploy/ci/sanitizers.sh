@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The unit suites of core, wire and server under ASan + UBSan (tree build-asan/, which also holds
+# the fuzz targets of deploy/ci/fuzz.sh), then the service tests under TSan (tree build-tsan/).
+# Each tree builds only what its tests need. Timings go to build-asan/sanitizers-summary.txt.
+#
+#   deploy/ci/sanitizers.sh          both
+#   deploy/ci/sanitizers.sh asan     only ASan + UBSan
+#   deploy/ci/sanitizers.sh tsan     only TSan
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+what=${1:-all}
+case "$what" in all | asan | tsan) ;; *) echo "usage: $0 [all|asan|tsan]" >&2; exit 2 ;; esac
+bash deploy/install-deps.sh
+source deploy/ci/common.sh
+
+summary=build-asan/sanitizers-summary.txt
+mkdir -p build-asan
+: > "$summary"
+step() {  # step NAME COMMAND...: runs, times and records one step
+  local name=$1 start
+  shift
+  start=$(now)
+  echo "== sanitizers: $name"
+  "$@"
+  echo "$name: $(($(now) - start)) s" | tee -a "$summary"
+}
+
+# run_tests TREE SUITE: the tests of one executable (each test is labelled with it).
+run_tests() {
+  ctest --test-dir "$1" -L "^$2\$" --output-on-failure -j "${JOBS:-2}" --timeout 900
+}
+
+if [ "$what" != tsan ]; then
+  step "asan configure" configure_tree build-asan -DTUBEPICK_SANITIZE=address,undefined -DTUBEPICK_FUZZ=ON
+  step "asan build (core_test wire_test server_test fuzz_targets)" \
+    build_targets build-asan core_test wire_test server_test fuzz_targets
+  step "asan core_test" run_tests build-asan core_test
+  step "asan wire_test" run_tests build-asan wire_test
+  step "asan server_test" run_tests build-asan server_test
+fi
+
+if [ "$what" != asan ]; then
+  # libgomp/libomp are not instrumented, so their hand-offs between threads look like races: the
+  # service runs one OpenMP thread per call here (modeling.threads 0 = OMP_NUM_THREADS; the
+  # simulation already uses planning.simulation_threads = 1). deploy/ci/tsan.supp lists what
+  # remains, each entry with its reason.
+  export OMP_NUM_THREADS=1
+  export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/deploy/ci/tsan.supp}
+  step "tsan configure" configure_tree build-tsan -DTUBEPICK_SANITIZE=thread
+  step "tsan build (service_test tubepick-server)" build_targets build-tsan service_test tubepick-server
+  step "tsan service_test" run_tests build-tsan service_test
+fi
+cat "$summary"
