@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <charconv>
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -207,6 +209,13 @@ XyzLayout FindXyz(const std::string& path, const PlyElement& vertex) {
   return layout;
 }
 
+/// `value` in its shortest exact decimal form ("nan", "-1", "2.5") for error messages.
+std::string NumberText(double value) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return ec == std::errc() ? std::string(buffer, end) : std::string("?");
+}
+
 [[noreturn]] void ThrowTruncated(const std::string& path, const PlyElement& element, std::uint64_t read) {
   ThrowCloudFileError(path, "truncated: the header declares " + std::to_string(element.count) + " " +
                                 element.name + " elements but the data ends after " + std::to_string(read));
@@ -223,10 +232,15 @@ void SkipBinaryProperty(const std::string& path, const PlyElement& element, std:
   if (body.size() - *offset < SizeOf(property.count_type)) ThrowTruncated(path, element, index);
   const double count = LoadAsDouble(body.data() + *offset, property.count_type, swap);
   *offset += SizeOf(property.count_type);
-  if (count < 0) ThrowCloudFileError(path, "negative list length in PLY element '" + element.name + "'");
-  const auto bytes = static_cast<std::uint64_t>(count) * SizeOf(property.type);
-  if (body.size() - *offset < bytes) ThrowTruncated(path, element, index);
-  *offset += bytes;
+  // A float or double count type is legal in the header, so the value may be anything: only a
+  // whole, non-negative number is a length (casting NaN or 1e300 to an integer is undefined).
+  if (!(count >= 0.0) || count != std::floor(count)) {
+    ThrowCloudFileError(path, "bad list length " + NumberText(count) + " in PLY element '" + element.name +
+                                  "' " + std::to_string(index));
+  }
+  const std::size_t item_size = SizeOf(property.type);
+  if (count > static_cast<double>((body.size() - *offset) / item_size)) ThrowTruncated(path, element, index);
+  *offset += static_cast<std::size_t>(count) * item_size;
 }
 
 /// Skips one binary element instance (with list properties) starting at `*offset`.

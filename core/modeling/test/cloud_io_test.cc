@@ -302,6 +302,42 @@ TEST(CloudIo, TruncatedBinaryPlyIsAnError) {
   ExpectReadError(path, {"truncated", "1000 vertices", "120 bytes"});
 }
 
+/// A binary PLY whose face element (before the vertices) has a list with a `count_type` count:
+/// one face whose count is `count`, followed by one vertex.
+template <typename Count>
+std::string PlyWithListCount(const std::string& count_type, Count count) {
+  std::string bytes = "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list " + count_type +
+                      " uchar vertex_indices\nelement vertex 1\nproperty float x\nproperty float y\n"
+                      "property float z\nend_header\n";
+  AppendLittleEndian(&bytes, count);
+  for (int i = 0; i < 3; ++i) AppendLittleEndian<std::uint8_t>(&bytes, 0);
+  for (float v : {1.0f, 2.0f, 3.0f}) AppendLittleEndian(&bytes, v);
+  return bytes;
+}
+
+TEST(CloudIo, PlyFloatListCountMustBeAWholeNumber) {
+  const std::string path = TempPath("cloud.ply");
+  WriteBytes(path, PlyWithListCount("float", std::numeric_limits<float>::quiet_NaN()));
+  ExpectReadError(path, {"bad list length nan", "element 'face' 0"});
+  WriteBytes(path, PlyWithListCount("double", 2.5));
+  ExpectReadError(path, {"bad list length 2.5", "element 'face' 0"});
+  WriteBytes(path, PlyWithListCount("double", -std::numeric_limits<double>::infinity()));
+  ExpectReadError(path, {"bad list length -inf"});
+  WriteBytes(path, PlyWithListCount("int", std::int32_t{-1}));
+  ExpectReadError(path, {"bad list length -1"});
+  // A whole number far beyond the data (and beyond 2^64) is a truncation, not an overflow.
+  WriteBytes(path, PlyWithListCount("double", 1e300));
+  ExpectReadError(path, {"truncated", "1 face elements"});
+}
+
+TEST(CloudIo, PlyFloatListCountThatIsWholeIsALength) {
+  const std::string path = TempPath("cloud.ply");
+  WriteBytes(path, PlyWithListCount("float", 3.0f));
+  const CloudFile cloud = ReadCloudFile(path);
+  ASSERT_EQ(cloud.points.size(), 1u);
+  EXPECT_EQ(cloud.points[0], Eigen::Vector3f(1.0f, 2.0f, 3.0f));
+}
+
 TEST(CloudIo, TruncatedAsciiPlyIsAnError) {
   std::string text =
       "ply\nformat ascii 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
