@@ -358,6 +358,8 @@ Points ReadAsciiVertices(const std::string& path, const PlyHeader& header, std::
   };
   for (std::size_t e = 0; e < vertex_index; ++e) {
     const PlyElement& element = header.elements[e];
+    // An element without properties has no text at all, whatever its count (up to 2^64 - 1).
+    if (element.properties.empty()) continue;
     for (std::uint64_t i = 0; i < element.count; ++i) skip_instance(element, i);
   }
 

@@ -338,6 +338,17 @@ TEST(CloudIo, PlyFloatListCountThatIsWholeIsALength) {
   EXPECT_EQ(cloud.points[0], Eigen::Vector3f(1.0f, 2.0f, 3.0f));
 }
 
+TEST(CloudIo, PlyAsciiElementWithoutPropertiesTakesNoTime) {
+  // 2^64 - 1 instances of nothing before the vertices: nothing to read, not a loop of 2^64 steps.
+  const std::string path = TempPath("cloud.ply");
+  WriteBytes(path,
+             "ply\nformat ascii 1.0\nelement marker 18446744073709551615\nelement vertex 1\n"
+             "property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n");
+  const CloudFile cloud = ReadCloudFile(path);
+  ASSERT_EQ(cloud.points.size(), 1u);
+  EXPECT_EQ(cloud.points[0], Eigen::Vector3f(1.0f, 2.0f, 3.0f));
+}
+
 TEST(CloudIo, TruncatedAsciiPlyIsAnError) {
   std::string text =
       "ply\nformat ascii 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
