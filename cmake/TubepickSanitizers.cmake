@@ -24,7 +24,9 @@ if(TUBEPICK_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "TUBEPICK_FUZZ needs clang (libFuzzer): -DCMAKE_CXX_COMPILER=clang++")
   endif()
-  # Coverage feedback for libFuzzer in every library the fuzz targets link; only the fuzz
-  # executables themselves link the fuzzer's main (-fsanitize=fuzzer, fuzz/CMakeLists.txt).
-  add_compile_options(-fsanitize=fuzzer-no-link)
+  # Coverage feedback for libFuzzer, compiled into the sources that read fuzzed input only
+  # (fuzz/coverage.allowlist): the unit tests of the same tree keep their speed. Only the fuzz
+  # executables link the fuzzer's main (-fsanitize=fuzzer, fuzz/CMakeLists.txt).
+  add_compile_options(-fsanitize=fuzzer-no-link
+                      -fsanitize-coverage-allowlist=${PROJECT_SOURCE_DIR}/fuzz/coverage.allowlist)
 endif()
