@@ -43,7 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     switch (selector) {
       case 0: {
-        const Params base = ProfileParams("fast");
+        static const Params base = ProfileParams("fast");
         const Params params = ParseParams(text, base);
         ReadBackOrAbort([&] {
           const std::string dump = DumpParams(params);
