@@ -124,7 +124,17 @@ void YamlMap::RejectUnknown() const {
   if (!node_.IsMap()) return;
   std::string unknown;
   for (const auto& kv : node_) {
-    const auto key = kv.first.as<std::string>();
+    // Our keys are names: a list or a mapping as a key ("[a]: 1", "? {a: 1}") is none of them,
+    // and would not convert to a string (yaml-cpp throws its own exception).
+    if (!kv.first.IsScalar()) {
+      throw InvalidArgument((path_.empty() ? std::string("document") : path_) +
+                            ": a key must be a name, got " +
+                            (kv.first.IsSequence() ? "a list"
+                             : kv.first.IsMap()    ? "a mapping"
+                                                   : "no key") +
+                            " (line " + std::to_string(kv.first.Mark().line + 1) + ")");
+    }
+    const std::string key = kv.first.Scalar();
     if (!used_.count(key)) unknown += (unknown.empty() ? "" : ", ") + PathOf(key);
   }
   if (!unknown.empty()) throw InvalidArgument("unknown key(s): " + unknown);

@@ -206,6 +206,14 @@ TEST(ConfigFields, UnknownKeysNameTheirPath) {
   EXPECT_THAT(ErrorOf("shapes: [{square: {sides: 4}}]"), HasSubstr("unknown key(s): shapes[0].square.sides"));
 }
 
+TEST(ConfigFields, KeysThatAreNotNamesAreErrorsNamingTheirPath) {
+  EXPECT_THAT(ErrorOf("[ratio]: 1"), HasSubstr("document: a key must be a name, got a list (line 1)"));
+  EXPECT_THAT(ErrorOf("inner:\n  ? {width: 1}\n  : 2\n"),
+              HasSubstr("inner: a key must be a name, got a mapping (line 2)"));
+  EXPECT_THAT(ErrorOf("shapes: [{square: {? [4] : 1}}]"),
+              HasSubstr("shapes[0].square: a key must be a name"));
+}
+
 TEST(ConfigFields, WrongTypesNameTheirPath) {
   EXPECT_THAT(ErrorOf("ratio: much"), HasSubstr("ratio: expected a number, got 'much'"));
   EXPECT_THAT(ErrorOf("offset: 1.5"), HasSubstr("offset: expected an integer"));
