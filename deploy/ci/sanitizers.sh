@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The unit suites of core, wire and server under ASan + UBSan (tree build-asan/, which also holds
-# the fuzz targets of deploy/ci/fuzz.sh), then the service tests of our own threads under TSan
-# (tree build-tsan/).
+# the fuzz targets of deploy/ci/fuzz.sh), then the server tests and the service suites of our own
+# threads under TSan (tree build-tsan/).
 # Each tree builds only what its tests need. Timings go to build-asan/sanitizers-summary.txt.
 #
 #   deploy/ci/sanitizers.sh          both
@@ -41,15 +41,17 @@ if [ "$what" != tsan ]; then
 fi
 
 if [ "$what" != asan ]; then
-  # TSan runs the service_test suites whose threads meet in our code (the worker pool, metrics,
-  # their HTTP endpoint, the request log). The gRPC call suites stay out: gRPC is not instrumented,
-  # so its hand-offs between threads look like races (deploy/ci/tsan.supp says why in full).
+  # TSan runs what meets on our own threads: server_test (planning jobs: the simulation's worker
+  # threads, stops from another thread) and the service_test suites of the worker pool, metrics,
+  # their HTTP endpoint and the request log. The gRPC call suites stay out: gRPC is not
+  # instrumented, so its hand-offs between threads look like races (deploy/ci/tsan.supp says why).
   # OpenMP's runtime is not instrumented either: one OpenMP thread (modeling.threads 0 follows
-  # OMP_NUM_THREADS; the simulation already uses planning.simulation_threads = 1).
+  # OMP_NUM_THREADS; the simulation threads are ours and stay on).
   export OMP_NUM_THREADS=1
   export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:ignore_noninstrumented_modules=1:suppressions=$PWD/deploy/ci/tsan.supp}
   step "tsan configure" configure_tree build-tsan -DTUBEPICK_SANITIZE=thread
-  step "tsan build (service_test)" build_targets build-tsan service_test
+  step "tsan build (server_test service_test)" build_targets build-tsan server_test service_test
+  step "tsan server_test" run_tests build-tsan server_test
   step "tsan service_test (WorkerPool, Metrics, MetricsHttp, RequestLog)" \
     run_tests build-tsan service_test -R '^(WorkerPool|Metrics|MetricsHttp|RequestLog)\.'
 fi
