@@ -20,6 +20,14 @@ if(TUBEPICK_SANITIZE)
   endif()
 endif()
 
+if(TUBEPICK_SANITIZE MATCHES "thread" AND TARGET OpenMP::OpenMP_CXX)
+  # libgomp / libomp are not instrumented: TSan would take their barriers for races. A TSan tree
+  # compiles the OpenMP pragmas out (every region runs on the calling thread) and still links the
+  # runtime for the omp_* calls; our own threads (the worker pool, the upload watchdog, the Bullet
+  # trajectory workers) are what it checks.
+  set_property(TARGET OpenMP::OpenMP_CXX PROPERTY INTERFACE_COMPILE_OPTIONS -Wno-unknown-pragmas)
+endif()
+
 if(TUBEPICK_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "TUBEPICK_FUZZ needs clang (libFuzzer): -DCMAKE_CXX_COMPILER=clang++")

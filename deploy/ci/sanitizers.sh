@@ -45,14 +45,13 @@ if [ "$what" != asan ]; then
   # threads, stops from another thread) and the service_test suites of the worker pool, metrics,
   # their HTTP endpoint and the request log. The gRPC call suites stay out: gRPC is not
   # instrumented, so its hand-offs between threads look like races (deploy/ci/tsan.supp says why).
-  # OpenMP's runtime is not instrumented either: one OpenMP thread (modeling.threads 0 follows
-  # OMP_NUM_THREADS; the simulation threads are ours and stay on).
-  export OMP_NUM_THREADS=1
+  # OpenMP's runtime is not instrumented either: the TSan tree compiles the OpenMP pragmas out
+  # (cmake/TubepickSanitizers.cmake); the simulation threads are ours and stay on.
   export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:ignore_noninstrumented_modules=1:suppressions=$PWD/deploy/ci/tsan.supp}
   step "tsan configure" configure_tree build-tsan -DTUBEPICK_SANITIZE=thread
   step "tsan build (server_test service_test)" build_targets build-tsan server_test service_test
   step "tsan server_test" run_tests build-tsan server_test
-  step "tsan service_test (WorkerPool, Metrics, MetricsHttp, RequestLog)" \
-    run_tests build-tsan service_test -R '^(WorkerPool|Metrics|MetricsHttp|RequestLog)\.'
+  step "tsan service_test (WorkerPool, UploadSlots, UploadWatchdog, Metrics, MetricsHttp, RequestLog)" \
+    run_tests build-tsan service_test -R '^(WorkerPool|UploadSlots|UploadWatchdog|Metrics|MetricsHttp|RequestLog)\.'
 fi
 cat "$summary"
