@@ -125,8 +125,10 @@ void CheckTrajectoryAgainst(const Trajectory& trajectory, std::size_t tube_count
 }  // namespace
 
 void TrajectorySimParams::Validate() const {
-  Require(gripper_speed > 0.0 && gripper_speed <= 10.0, "gripper_speed", gripper_speed, "0 < v ≤ 10 m/s");
-  Require(time_step > 0.0 && time_step <= 0.1, "time_step", time_step, "0 < dt ≤ 0.1 s");
+  // Lower bounds keep the step counts (path / (v·dt), post_motion_time / dt) well inside an int.
+  Require(gripper_speed >= 1e-4 && gripper_speed <= 10.0, "gripper_speed", gripper_speed,
+          "0.1 mm/s ≤ v ≤ 10 m/s");
+  Require(time_step >= 1e-4 && time_step <= 0.1, "time_step", time_step, "0.1 ms ≤ dt ≤ 0.1 s");
   Require(solver_iterations >= 1 && solver_iterations <= 1000, "solver_iterations", solver_iterations,
           "1 … 1000");
   Require(settle_time >= 0.0 && settle_time <= 3600.0, "settle_time", settle_time, "0 ≤ t ≤ 3600 s");
@@ -156,7 +158,7 @@ void TrajectorySimParams::Validate() const {
   Require(sleep_angular_velocity >= 0.0 && Finite(sleep_angular_velocity), "sleep_angular_velocity",
           sleep_angular_velocity, "≥ 0 rad/s");
   Require(wall_thickness > 0.0 && wall_thickness <= 1.0, "wall_thickness", wall_thickness, "0 < t ≤ 1 m");
-  Require(threads >= 0 && threads <= 1024, "threads", threads, "0 (hardware) … 1024");
+  Require(threads >= 0 && threads <= 1024, "threads", threads, "0 (all cores) … 1024");
   for (int i = 0; i < 3; ++i) {
     Require(bin.inner_size[i] > 0.0 && Finite(bin.inner_size[i]), "bin.inner_size[" + std::to_string(i) + "]",
             bin.inner_size[i], "> 0 m");

@@ -150,11 +150,20 @@ YAML::Node ParseYaml(const std::string& text, const std::string& what) {
 }
 
 std::string ReadTextFile(const std::string& path) {
-  std::ifstream in(path);
+  // Configs are kilobytes: a path to a device or a huge file is a mistake, not a config to read forever.
+  constexpr std::size_t kMaxBytes = 16u << 20;
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InvalidArgument("cannot open '" + path + "'");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  std::string text;
+  char buffer[65536];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    text.append(buffer, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxBytes) {
+      throw InvalidArgument("'" + path + "' is larger than " + std::to_string(kMaxBytes >> 20) +
+                            " MiB: not a config file");
+    }
+  }
+  return text;
 }
 
 }  // namespace tubepick

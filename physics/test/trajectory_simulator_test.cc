@@ -292,7 +292,10 @@ TEST(TrajectorySimulator, DeadlineStopsTheSimulation) {
 TEST(TrajectorySimulator, InvalidParamsAreNamed) {
   const std::vector<std::pair<std::string, std::function<void(TrajectorySimParams&)>>> cases = {
       {"gripper_speed", [](TrajectorySimParams& p) { p.gripper_speed = 0.0; }},
+      // So slow or so fine that the step count would overflow an int.
+      {"gripper_speed", [](TrajectorySimParams& p) { p.gripper_speed = 1e-300; }},
       {"time_step", [](TrajectorySimParams& p) { p.time_step = -1.0; }},
+      {"time_step", [](TrajectorySimParams& p) { p.time_step = 1e-300; }},
       {"solver_iterations", [](TrajectorySimParams& p) { p.solver_iterations = 0; }},
       {"settle_time", [](TrajectorySimParams& p) { p.settle_time = std::nan(""); }},
       {"rest_time", [](TrajectorySimParams& p) { p.rest_time = -0.1; }},

@@ -247,5 +247,15 @@ TEST(ConfigFields, PartialInputOverridesOnlyItsKeys) {
   EXPECT_EQ(e.ratio, Everything{}.ratio);
 }
 
+// A config path that names a device or a huge file is an error, not a read without end.
+TEST(ReadTextFile, RefusesMoreThanAConfigsWorth) {
+  try {
+    (void)ReadTextFile("/dev/zero");
+    ADD_FAILURE() << "read /dev/zero";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("'/dev/zero' is larger than 16 MiB"));
+  }
+}
+
 }  // namespace config_fields_test
 }  // namespace tubepick
