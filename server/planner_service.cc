@@ -22,6 +22,18 @@ using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
+// A config's seconds as a steady-clock duration.
+Clock::duration Seconds(double seconds) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+// A caller mistake's status: RESOURCE_EXHAUSTED for one over a size limit (TooLarge, the code gRPC
+// gives a message over max_message_bytes), INVALID_ARGUMENT for the rest. Every path maps it here.
+grpc::Status CallerMistake(const InvalidArgument& e) {
+  const bool too_large = dynamic_cast<const TooLarge*>(&e) != nullptr;
+  return {too_large ? grpc::StatusCode::RESOURCE_EXHAUSTED : grpc::StatusCode::INVALID_ARGUMENT, e.what()};
+}
+
 // A client's x-request-id is kept when it is 1..128 printable ASCII characters without spaces
 // (it goes into log lines and metadata verbatim); anything else gets a fresh id.
 bool SaneRequestId(std::string_view id) {
@@ -67,8 +79,7 @@ struct PlannerService::CallState {
     record.peer = context->peer();
     deadline = SteadyDeadline(*context);
     if (!deadline) {  // no call runs forever: server.max_call_time is the deadline of one that sets none
-      deadline =
-          arrived + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(max_call_time));
+      deadline = arrived + Seconds(max_call_time);
       max_call_time_s = max_call_time;
     }
     token.set_deadline(*deadline);
@@ -169,11 +180,8 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
           return;
         }
       }
-    } catch (const TooLarge& e) {
-      Answer(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what()));
-      return;
     } catch (const InvalidArgument& e) {
-      Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what()));
+      Answer(CallerMistake(e));
       return;
     }
     message_.Clear();
@@ -236,7 +244,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
     try {
       cloud_ = assembler_.Finish();  // cheap: checks chunks, size and CRC, moves the joined bytes
     } catch (const InvalidArgument& e) {
-      Answer(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what()));
+      Answer(CallerMistake(e));
       return;
     }
     const Clock::time_point enqueued = Clock::now();
@@ -299,8 +307,7 @@ PlannerService::PlannerService(ServerConfig config, WorkerPool* pool, Metrics* m
       pool_(pool),
       metrics_(metrics),
       uploads_(config_.max_uploads),
-      upload_watchdog_(std::chrono::duration_cast<Clock::duration>(
-          std::chrono::duration<double>(config_.stream_idle_timeout))) {}
+      upload_watchdog_(Seconds(config_.stream_idle_timeout)) {}
 
 void PlannerService::Register(StopToken* token) {
   std::lock_guard lock(calls_mu_);
@@ -363,10 +370,8 @@ grpc::Status PlannerService::RunOnWorker(CallState& call, Clock::time_point enqu
     body();
   } catch (const Cancelled& e) {
     status = call.CancelledStatus(e.what());
-  } catch (const TooLarge& e) {
-    status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what());
   } catch (const InvalidArgument& e) {
-    status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+    status = CallerMistake(e);
   } catch (const FailedPrecondition& e) {
     status = grpc::Status(grpc::StatusCode::FAILED_PRECONDITION, e.what());
   } catch (const std::exception& e) {
@@ -441,7 +446,7 @@ grpc::ServerUnaryReactor* PlannerService::AnalyzeWrench(grpc::CallbackServerCont
     const WrenchJob job = ValidateAnalyzeWrench(*request, config_.planning);
     *response = RunAnalyzeWrench(job);
   } catch (const InvalidArgument& e) {
-    status = grpc::Status(grpc::StatusCode::INVALID_ARGUMENT, e.what());
+    status = CallerMistake(e);
   } catch (const std::exception& e) {
     spdlog::error("AnalyzeWrench {}: internal error: {}", call->state().record.request_id, e.what());
     status = grpc::Status(grpc::StatusCode::INTERNAL,
