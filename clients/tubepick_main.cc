@@ -5,6 +5,7 @@
 
 #include "clients/cli/cell/cell_command.h"
 #include "clients/cli/eval/eval_command.h"
+#include "clients/cli/load/bench_service.h"
 #include "clients/cli/load/load_command.h"
 #include "clients/cli/local/bench_command.h"
 #include "clients/cli/local/model_command.h"
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   tubepick::cli::AddModelCommand(app);
   tubepick::cli::AddParamsCommand(app);
   tubepick::cli::AddPlanCommand(app);
-  tubepick::cli::AddBenchCommand(app);
+  tubepick::cli::AddBenchServiceCommand(*tubepick::cli::AddBenchCommand(app));
   tubepick::cli::AddSceneCommand(app);
   tubepick::cli::AddEvalCommand(app);
   tubepick::cli::AddCellCommand(app);

@@ -3,7 +3,7 @@
 // Input: a sequence of PlanPickStreamRequest messages, each preceded by its size as a varint (the
 // protobuf "delimited" form; fuzz/make_corpus.py writes the seeds). They are fed to a
 // CloudStreamAssembler as the server does, then Finish(); the joined bytes go through the stream
-// request's validation (DecodeCloud included). Accepted: InvalidArgument / FailedPrecondition naming
+// request's validation (CheckCloudBytes included). Accepted: InvalidArgument / FailedPrecondition naming
 // the mistake. Anything else, a sanitizer report or a broken invariant below, is a crash.
 
 #include <cstddef>
@@ -46,11 +46,11 @@ void CheckCrc(std::string_view bytes) {
   Check(Crc32c(bytes) == Crc32c(bytes.substr(half), Crc32c(bytes.substr(0, half))));
 }
 
-// DecodeCloud on the raw input: either a point per 12 bytes or InvalidArgument.
-void CheckDecodeCloud(std::string_view bytes) {
+// CheckCloudBytes on the raw input: the bytes themselves (12 a point) or InvalidArgument.
+void CheckCloudBytes(std::string_view bytes) {
   try {
-    const Points points = server::DecodeCloud(bytes, kMaxPoints, "cloud.xyz");
-    Check(points.size() * 12 == bytes.size());
+    const std::string_view checked = server::CheckCloudBytes(bytes, kMaxPoints, "cloud.xyz");
+    Check(checked.data() == bytes.data() && checked.size() == bytes.size() && bytes.size() % 12 == 0);
   } catch (const InvalidArgument&) {
   }
 }
@@ -66,7 +66,7 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   CheckCrc(bytes);
-  CheckDecodeCloud(bytes);
+  CheckCloudBytes(bytes);
 
   google::protobuf::io::CodedInputStream input(data, static_cast<int>(size));
   CloudStreamAssembler assembler(kMaxStreamBytes);

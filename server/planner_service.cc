@@ -195,7 +195,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   }
 
  private:
-  // The point limit of planning.max_cloud_points, checked at the header (as DecodeCloud checks a
+  // The point limit of planning.max_cloud_points, checked at the header (as CheckCloudBytes checks a
   // unary request's cloud), before anything is admitted or reserved.
   void RequireAnnouncedPointsWithinLimit(std::uint64_t announced_bytes) const {
     const std::uint64_t limit = service_->config_.planning.max_cloud_points;
@@ -250,11 +250,11 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
     const Clock::time_point enqueued = Clock::now();
     const WorkerPool::Admission admission = service_->pool_->TrySubmit([this, enqueued] {
       const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
-        PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
-        std::string().swap(cloud_);  // the decoded points are all that is needed now
-        state_.record.points = job.points_Sensor.size();
+        const PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
+        state_.record.points = job.xyz_Sensor.size() / 12;
         *response_->mutable_response() =
             RunPlanPick(job, service_->config_.planning, service_->threads_per_call_, &state_.token);
+        std::string().swap(cloud_);  // modeling read the bytes in place
         state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
         state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
       });
@@ -295,7 +295,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   v1::PlanPickStreamResponse* response_;
   v1::PlanPickStreamRequest message_;
   CloudStreamAssembler assembler_;
-  /// The joined cloud bytes of a complete upload, until the job has decoded them.
+  /// The joined cloud bytes of a complete upload, until the job has modeled them.
   std::string cloud_;
   UploadSlots::Slot upload_slot_;
   std::shared_ptr<UploadWatch> watch_;

@@ -1,5 +1,6 @@
 #include "server/planning_jobs.h"
 
+#include <chrono>
 #include <memory>
 #include <optional>
 
@@ -14,10 +15,13 @@
 namespace tubepick::server {
 namespace {
 
-ModelingResult Model(const PlanningJob& job, std::uint32_t threads, const StopToken* stop) {
+// raw_region_Bin: the raw points the caller needs kept (ModelingInput::raw_region_Bin).
+ModelingResult Model(const PlanningJob& job, const RawRegion& raw_region_Bin, std::uint32_t threads,
+                     const StopToken* stop) {
   ThrowIfStopped(stop, "request admission");
   ModelingInput input;
-  input.points_Sensor = &job.points_Sensor;
+  input.xyz_Sensor = PackedXyz{job.xyz_Sensor};
+  input.raw_region_Bin = raw_region_Bin;
   input.unit = job.unit;
   input.X_BinSensor = job.cell.sensor.X_BinSensor;
   input.bin = job.cell.bin;
@@ -30,12 +34,13 @@ ModelingResult Model(const PlanningJob& job, std::uint32_t threads, const StopTo
 }  // namespace
 
 v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, std::uint32_t threads, const StopToken* stop) {
-  return ToModelTubesResponse(Model(job, threads, stop), job.profile, job.seed);
+  return ToModelTubesResponse(Model(job, RawRegion::None(), threads, stop), job.profile, job.seed);
 }
 
 v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults& defaults,
                                  std::uint32_t threads, const StopToken* stop) {
-  const ModelingResult modeling = Model(job, threads, stop);
+  const ModelingResult modeling =
+      Model(job, RawRegionForPlanning(job.params.planning, job.cell.bin), threads, stop);
 
   std::unique_ptr<physics::BulletTrajectoryEvaluator> evaluator;
   if (!job.disable_simulation) {
@@ -45,8 +50,19 @@ v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults&
   PickPlanResult plan = PlanPick(modeling, job.cell, job.params.planning, evaluator.get(), job.seed, stop);
   // Truncate first: placements are computed only for the plans that are sent.
   if (job.max_plans > 0 && plan.plans.size() > job.max_plans) plan.plans.resize(job.max_plans);
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  Clock::time_point t0 = Clock::now();
   AttachPlacements(modeling, job.cell.place.X_BinPlace, job.params.placement, &plan);
-  return ToPlanPickResponse(plan, modeling, job.profile, job.seed);
+  plan.timings.push_back({"placement", seconds_since(t0)});
+  t0 = Clock::now();
+  v1::PlanPickResponse response = ToPlanPickResponse(plan, modeling, job.profile, job.seed);
+  v1::StageTiming* timing = response.add_stage_timings();
+  timing->set_stage("response");  // building this message (gRPC then serializes it)
+  timing->set_seconds(seconds_since(t0));
+  return response;
 }
 
 v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job) {

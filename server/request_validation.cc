@@ -8,7 +8,6 @@
 
 #include "core/common/errors.h"
 #include "core/common/require.h"
-#include "wire/packed_cloud.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::server {
@@ -114,7 +113,7 @@ v1::PlanPickRequest AsPlanPick(const v1::ModelTubesRequest& request) {
 
 }  // namespace
 
-Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::string& field) {
+std::string_view CheckCloudBytes(std::string_view xyz, std::uint64_t max_points, const std::string& field) {
   if (xyz.empty()) throw InvalidArgument(field + ": empty cloud (0 bytes); at least one point is needed");
   if (xyz.size() % 12 != 0) {
     throw InvalidArgument(field + ": " + std::to_string(xyz.size()) +
@@ -125,7 +124,7 @@ Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::st
     throw TooLarge(field + ": " + std::to_string(count) + " points exceed the limit of " +
                    std::to_string(max_points) + " (planning.max_cloud_points)");
   }
-  return UnpackXyz(xyz);
+  return xyz;
 }
 
 CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults& defaults,
@@ -172,14 +171,14 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
 
 PlanningJob ValidateModelTubes(const v1::ModelTubesRequest& request, const PlanningDefaults& defaults) {
   PlanningJob job = ValidateContext(AsPlanPick(request), defaults, "");
-  job.points_Sensor = DecodeCloud(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
+  job.xyz_Sensor = CheckCloudBytes(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
   return job;
 }
 
 PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, const PlanningDefaults& defaults) {
   PlanningJob job = ValidateContext(request, defaults, "");
   RequireTubeFitsGripper(job, request.has_cell(), "");
-  job.points_Sensor = DecodeCloud(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
+  job.xyz_Sensor = CheckCloudBytes(request.cloud().xyz(), defaults.max_cloud_points, "cloud.xyz");
   return job;
 }
 
@@ -192,7 +191,7 @@ PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, std::string_vie
   }
   PlanningJob job = ValidateContext(request, defaults, "header.request.");
   RequireTubeFitsGripper(job, request.has_cell(), "header.request.");
-  job.points_Sensor = DecodeCloud(cloud_xyz, defaults.max_cloud_points, "chunks (the streamed cloud)");
+  job.xyz_Sensor = CheckCloudBytes(cloud_xyz, defaults.max_cloud_points, "chunks (the streamed cloud)");
   return job;
 }
 

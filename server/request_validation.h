@@ -19,8 +19,10 @@ namespace tubepick::server {
 /// "cell.tube_radius", "options.profile", ...), the reason and the offending value. The server maps
 /// that to INVALID_ARGUMENT.
 struct PlanningJob {
-  /// Decoded points in the sensor frame, in `unit` (non-finite points kept: modeling drops them).
-  Points points_Sensor;
+  /// The cloud's packed float32 x, y, z bytes (sensor frame, in `unit`), checked but not decoded:
+  /// modeling reads them in place (non-finite points included: it drops them). A view into the
+  /// request (or the joined stream), which outlives the job.
+  std::string_view xyz_Sensor;
   LengthUnit unit = LengthUnit::kMetre;
   CellConfig cell;
   std::string profile;
@@ -30,9 +32,9 @@ struct PlanningJob {
   std::uint32_t max_plans = 0;
 };
 
-/// Checks a packed float32 xyz byte string (non-empty, a multiple of 12, at most max_points) and
-/// decodes it (little-endian). @throws InvalidArgument naming `field`.
-Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::string& field);
+/// Checks a packed float32 xyz byte string: non-empty, a multiple of 12, at most max_points points.
+/// @returns `xyz` (not copied). @throws InvalidArgument (TooLarge past max_points) naming `field`.
+std::string_view CheckCloudBytes(std::string_view xyz, std::uint64_t max_points, const std::string& field);
 
 /// The cell of a request: `defaults.cell` when absent, else every field required and checked:
 /// finite; poses with unit quaternions within 1e-3 (then normalised; a zero quaternion is an error);
@@ -42,13 +44,16 @@ Points DecodeCloud(std::string_view xyz, std::uint64_t max_points, const std::st
 CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults& defaults,
                         const std::string& field);
 
-/// Cloud (DecodeCloud, `defaults.max_cloud_points`), cell (ValidateCell), cloud.unit (UNSPECIFIED ⇒
+/// Cloud (CheckCloudBytes, `defaults.max_cloud_points`), cell (ValidateCell), cloud.unit (UNSPECIFIED ⇒
 /// the cell's sensor unit; numbers the enum does not define are errors), options.profile (empty ⇒
 /// defaults.profile; unknown ⇒ error listing the known ones), options.seed (absent ⇒ defaults.seed).
 PlanningJob ValidateModelTubes(const v1::ModelTubesRequest& request, const PlanningDefaults& defaults);
+/// The job views the request's cloud bytes: a temporary request would leave the view dangling.
+PlanningJob ValidateModelTubes(v1::ModelTubesRequest&& request, const PlanningDefaults& defaults) = delete;
 /// As ValidateModelTubes, and the tube must fit the profile's gripper opening
 /// (2 · tube radius < planning.grasps.opening_width).
 PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, const PlanningDefaults& defaults);
+PlanningJob ValidatePlanPick(v1::PlanPickRequest&& request, const PlanningDefaults& defaults) = delete;
 /// PlanPickStream: the header's request (whose cloud.xyz must be empty) and the joined bytes.
 /// Fields are named as in the stream ("header.request.cell.tube_radius").
 PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, std::string_view cloud_xyz,

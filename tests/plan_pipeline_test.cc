@@ -1,5 +1,10 @@
 // Planning on generated scenes: physics drop -> virtual scan -> modeling -> planning with the
 // Bullet trajectory evaluator, as the service will run it.
+#include <bit>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "core/modeling/model_tubes.h"
@@ -82,6 +87,79 @@ TEST(PlanPipeline, SameSeedSamePlans) {
     EXPECT_EQ(a.plan.plans[i].costs.total, b.plan.plans[i].costs.total);
     EXPECT_TRUE(a.plan.plans[i].grasp.X_BinTcp.isApprox(b.plan.plans[i].grasp.X_BinTcp, 0.0));
   }
+}
+
+// Little-endian float32 x, y, z per point, as PlanPickRequest.cloud.xyz carries them.
+std::string PackedLittleEndian(const Points& points) {
+  std::string bytes(points.size() * 12, '\0');
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const auto bits = std::bit_cast<std::uint32_t>(points[i][k]);
+      for (int b = 0; b < 4; ++b) bytes[12 * i + 4 * k + b] = static_cast<char>((bits >> (8 * b)) & 0xffu);
+    }
+  }
+  return bytes;
+}
+
+void ExpectSamePlans(const PickPlanResult& a, const PickPlanResult& b) {
+  ASSERT_EQ(a.plans.size(), b.plans.size());
+  for (std::size_t i = 0; i < a.plans.size(); ++i) {
+    EXPECT_EQ(a.plans[i].tube_id, b.plans[i].tube_id) << "plan " << i;
+    EXPECT_EQ(a.plans[i].costs.total, b.plans[i].costs.total) << "plan " << i;
+    EXPECT_TRUE(a.plans[i].grasp.X_BinTcp.isApprox(b.plans[i].grasp.X_BinTcp, 0.0)) << "plan " << i;
+  }
+  EXPECT_EQ(a.counts.grasp_candidates, b.counts.grasp_candidates);
+  EXPECT_EQ(a.counts.rejected_tool, b.counts.rejected_tool);
+  EXPECT_EQ(a.counts.rejected_fingers, b.counts.rejected_fingers);
+}
+
+// The service's path (the packed bytes read in place, only the raw points a finger box can reach
+// kept) plans exactly what the reference path (decoded points, every raw point kept) plans.
+TEST(PlanPipeline, ServicePathPlansExactlyAsTheReferencePath) {
+  const CellConfig cell;
+  const Params params = ProfileParams("fast");
+  std::uint64_t finger_rejections = 0;
+  for (const std::uint64_t seed : {3u, 8u}) {
+    physics::SceneParams scene;
+    scene.tube_count = 10;
+    scene.bin = cell.bin;
+    const physics::DropResult drop = physics::GenerateScene(scene, seed);
+    const physics::ScanResult scan = physics::ScanScene(drop.tubes, cell, physics::ScannerParams{}, seed);
+    ModelingInput reference;
+    reference.points_Sensor = &scan.points_Sensor;
+    reference.X_BinSensor = cell.sensor.X_BinSensor;
+    reference.bin = cell.bin;
+    reference.seed = seed;
+    const std::string bytes = PackedLittleEndian(scan.points_Sensor);
+    ModelingInput service = reference;
+    service.points_Sensor = nullptr;
+    service.xyz_Sensor = PackedXyz{bytes};
+    service.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
+
+    const ModelingResult a = ModelTubes(reference, params.modeling);
+    const ModelingResult b = ModelTubes(service, params.modeling);
+    EXPECT_EQ(a.filtered.points, b.filtered.points);
+    EXPECT_EQ(a.filtered_source_index, b.filtered_source_index);
+    ASSERT_EQ(a.tubes.size(), b.tubes.size());
+    // The floor and the walls, most of the scan, are left out.
+    EXPECT_LT(b.raw_Bin.size(), a.raw_Bin.size() / 4) << b.raw_Bin.size() << " of " << a.raw_Bin.size();
+
+    const PickPlanResult plan_a = PlanPick(a, cell, params.planning, nullptr, seed);
+    const PickPlanResult plan_b = PlanPick(b, cell, params.planning, nullptr, seed);
+    ExpectSamePlans(plan_a, plan_b);
+    finger_rejections += plan_a.counts.rejected_fingers;
+  }
+  EXPECT_GT(finger_rejections, 0u);  // the finger test was exercised
+}
+
+TEST(PlanPipeline, PlanningOnTooFewRawPointsIsAnError) {
+  const CellConfig cell;
+  const Params params = ProfileParams("fast");
+  ModelingResult modeling;
+  modeling.raw_region_Bin = RawRegion::None();
+  EXPECT_THROW(PlanPick(modeling, cell, params.planning, nullptr, 0), std::logic_error);
+  modeling.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
+  EXPECT_NO_THROW(PlanPick(modeling, cell, params.planning, nullptr, 0));
 }
 
 }  // namespace

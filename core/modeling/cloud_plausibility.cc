@@ -56,39 +56,51 @@ void PlausibilityParams::Validate() const {
   RequireInRange(min_floor_share, 0.0, 1.0, "modeling.plausibility.min_floor_share");
 }
 
-CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfig& bin,
-                                        const PlausibilityParams& params) {
-  CloudPlausibility e;
-  e.points = points_Bin.size();
+PlausibilityTally::PlausibilityTally(const BinConfig& bin, const PlausibilityParams& params,
+                                     std::size_t expected_points)
+    : bin_(bin), params_(params) {
+  // Bounds in float, the points' precision.
   const double hx = 0.5 * bin.inner_size.x(), hy = 0.5 * bin.inner_size.y();
-  const double ax = hx + params.margin_xy, ay = hy + params.margin_xy;
-  const double z_lo = -params.below_floor, z_hi = bin.inner_size.z() + params.above_walls;
-  for (const Eigen::Vector3f& p : points_Bin) {
-    const double x = std::abs(p.x()), y = std::abs(p.y()), z = p.z();
-    if (x <= ax && y <= ay && z >= z_lo && z <= z_hi) ++e.inside;
-    if (x <= hx && y <= hy && std::abs(z) <= params.floor_tolerance) ++e.on_floor;
-  }
+  volume_x_ = static_cast<float>(hx + params.margin_xy);
+  volume_y_ = static_cast<float>(hy + params.margin_xy);
+  volume_z_lo_ = static_cast<float>(-params.below_floor);
+  volume_z_hi_ = static_cast<float>(bin.inner_size.z() + params.above_walls);
+  floor_x_ = static_cast<float>(hx);
+  floor_y_ = static_cast<float>(hy);
+  floor_tolerance_ = static_cast<float>(params.floor_tolerance);
+  stride_ = std::max<std::size_t>(1, expected_points / kExtentSample);
+  sample_.reserve(expected_points / stride_ + 1);
+}
+
+CloudPlausibility PlausibilityTally::Finish() const {
+  CloudPlausibility e;
+  e.points = points_;
+  e.inside = inside_;
+  e.on_floor = on_floor_;
   if (e.points > 0) e.inside_share = static_cast<double>(e.inside) / static_cast<double>(e.points);
   if (e.inside > 0) e.floor_share = static_cast<double>(e.on_floor) / static_cast<double>(e.inside);
-  e.enough_inside = e.points > 0 && e.inside_share >= params.min_inside_share;
+  e.enough_inside = e.points > 0 && e.inside_share >= params_.min_inside_share;
   e.floor_seen =
-      e.on_floor > 0 && e.on_floor >= params.min_floor_points && e.floor_share >= params.min_floor_share;
-
-  if (e.points > 0) {
-    const std::size_t stride = std::max<std::size_t>(1, points_Bin.size() / kExtentSample);
-    std::vector<float> axis;
-    axis.reserve(points_Bin.size() / stride + 1);
+      e.on_floor > 0 && e.on_floor >= params_.min_floor_points && e.floor_share >= params_.min_floor_share;
+  if (!sample_.empty()) {
+    std::vector<float> axis(sample_.size());
     for (int d = 0; d < 3; ++d) {
-      axis.clear();
-      for (std::size_t i = 0; i < points_Bin.size(); i += stride) axis.push_back(points_Bin[i][d]);
+      for (std::size_t i = 0; i < sample_.size(); ++i) axis[i] = sample_[i][d];
       const double lo = Quantile(axis, 0.01), hi = Quantile(axis, 0.99);
       e.extent[d] = hi - lo;
       e.median[d] = Quantile(axis, 0.5);
     }
-    const double bin_size = std::max({bin.inner_size.x(), bin.inner_size.y(), bin.inner_size.z()});
-    e.extent_ratio = e.extent.maxCoeff() / bin_size;
+    const Eigen::Vector3d& s = bin_.inner_size;
+    e.extent_ratio = e.extent.maxCoeff() / std::max({s.x(), s.y(), s.z()});
   }
   return e;
+}
+
+CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfig& bin,
+                                        const PlausibilityParams& params) {
+  PlausibilityTally tally(bin, params, points_Bin.size());
+  for (const Eigen::Vector3f& p : points_Bin) tally.Add(p);
+  return tally.Finish();
 }
 
 std::string DescribeImplausibleCloud(const CloudPlausibility& e, const BinConfig& bin, LengthUnit unit,
@@ -118,14 +130,11 @@ std::string DescribeImplausibleCloud(const CloudPlausibility& e, const BinConfig
   return text;
 }
 
-CloudPlausibility RequirePlausibleCloud(const Points& points_Bin, const BinConfig& bin, LengthUnit unit,
-                                        const Eigen::Isometry3d& X_BinSensor,
-                                        const PlausibilityParams& params) {
-  CloudPlausibility evidence = CheckCloudAgainstCell(points_Bin, bin, params);
+void RequirePlausible(const CloudPlausibility& evidence, const BinConfig& bin, LengthUnit unit,
+                      const Eigen::Isometry3d& X_BinSensor, const PlausibilityParams& params) {
   if (params.check && !evidence.plausible()) {
     throw FailedPrecondition(DescribeImplausibleCloud(evidence, bin, unit, X_BinSensor, params));
   }
-  return evidence;
 }
 
 }  // namespace tubepick

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -53,6 +55,37 @@ struct CloudPlausibility {
   bool plausible() const { return enough_inside && floor_seen; }
 };
 
+/// The evidence of CheckCloudAgainstCell, gathered one point at a time, so that the pass that brings
+/// a cloud into the bin frame measures it too (cloud_prepare.h). Add the finite points in order, then
+/// Finish once.
+class PlausibilityTally {
+ public:
+  /// `expected_points`: how many points may be added (sets the stride of the extent sample: every
+  /// k-th point, about 100 k of them).
+  PlausibilityTally(const BinConfig& bin, const PlausibilityParams& params, std::size_t expected_points);
+
+  void Add(const Eigen::Vector3f& p_Bin) {
+    const float x = std::abs(p_Bin.x()), y = std::abs(p_Bin.y()), z = p_Bin.z();
+    inside_ += (x <= volume_x_ && y <= volume_y_ && z >= volume_z_lo_ && z <= volume_z_hi_) ? 1 : 0;
+    on_floor_ += (x <= floor_x_ && y <= floor_y_ && std::abs(z) <= floor_tolerance_) ? 1 : 0;
+    if (until_sample_-- == 0) {
+      sample_.push_back(p_Bin);
+      until_sample_ = stride_ - 1;
+    }
+    ++points_;
+  }
+
+  CloudPlausibility Finish() const;
+
+ private:
+  const BinConfig& bin_;
+  const PlausibilityParams& params_;
+  float volume_x_, volume_y_, volume_z_lo_, volume_z_hi_, floor_x_, floor_y_, floor_tolerance_;
+  std::size_t stride_ = 1, until_sample_ = 0;
+  std::uint64_t points_ = 0, inside_ = 0, on_floor_ = 0;
+  Points sample_;
+};
+
 /// Measures how well `points_Bin` (metres, bin frame) fits `bin`. Pure; O(n).
 CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfig& bin,
                                         const PlausibilityParams& params);
@@ -62,11 +95,9 @@ CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfi
 std::string DescribeImplausibleCloud(const CloudPlausibility& evidence, const BinConfig& bin, LengthUnit unit,
                                      const Eigen::Isometry3d& X_BinSensor, const PlausibilityParams& params);
 
-/// Checks the cloud and throws when it does not look like the cell (params.check = false: never).
+/// Throws when `evidence` says the cloud does not look like the cell (params.check = false: never).
 /// @throws FailedPrecondition with DescribeImplausibleCloud's message.
-/// @returns the evidence.
-CloudPlausibility RequirePlausibleCloud(const Points& points_Bin, const BinConfig& bin, LengthUnit unit,
-                                        const Eigen::Isometry3d& X_BinSensor,
-                                        const PlausibilityParams& params);
+void RequirePlausible(const CloudPlausibility& evidence, const BinConfig& bin, LengthUnit unit,
+                      const Eigen::Isometry3d& X_BinSensor, const PlausibilityParams& params);
 
 }  // namespace tubepick

@@ -1,5 +1,5 @@
-// radius_outlier and statistical_outlier: neighbourhood-density filters on a k-d tree
-// (the semantics of pcl::RadiusOutlierRemoval and pcl::StatisticalOutlierRemoval).
+// radius_outlier and statistical_outlier: neighbourhood-density filters (the semantics of
+// pcl::RadiusOutlierRemoval on a hash grid, of pcl::StatisticalOutlierRemoval on a k-d tree).
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +9,7 @@
 #include <pcl/point_types.h>
 
 #include "core/modeling/filters_internal.h"
+#include "core/modeling/neighbour_grid.h"
 
 namespace tubepick::internal {
 namespace {
@@ -42,25 +43,26 @@ std::vector<std::uint32_t> FiniteIndices(const Points& points) {
 std::vector<std::uint32_t> RadiusOutlierFilter(const RadiusOutlierParams& params, const Points& points_Bin,
                                                const StopToken* stop) {
   if (params.min_neighbours == 0) return FiniteIndices(points_Bin);
-  std::size_t finite_count = 0;
-  const auto cloud = ToPcl(points_Bin, &finite_count);
+  // A hash grid of cell size = radius (not PCL's FLANN tree, whose every query opens an OpenMP
+  // region: 40 k queries cost more in thread wake-ups than in searching).
+  const NeighbourGrid grid(points_Bin, static_cast<float>(params.radius));
   std::vector<std::uint32_t> kept;
-  if (finite_count <= params.min_neighbours) return kept;  // nobody can have enough neighbours
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree;                    // sorted results: the last is the farthest
-  tree.setInputCloud(cloud);
+  if (grid.size() <= params.min_neighbours) return kept;  // nobody can have enough neighbours
   // The point itself is its own nearest neighbour: it has min_neighbours others within the radius
   // exactly when its (min_neighbours + 1)-th nearest point is within the radius.
-  const int k = static_cast<int>(params.min_neighbours) + 1;
-  const float radius_squared = static_cast<float>(params.radius * params.radius);
-  pcl::Indices neighbours(k);
-  std::vector<float> squared_distances(k);
-  kept.reserve(points_Bin.size());
-  for (std::size_t i = 0; i < points_Bin.size(); ++i) {
-    if (i % kStopPollInterval == 0) ThrowIfStopped(stop, "filter radius_outlier");
-    if (!points_Bin[i].allFinite()) continue;
-    const int found = tree.nearestKSearch((*cloud)[i], k, neighbours, squared_distances);
-    if (found == k && squared_distances[k - 1] <= radius_squared)
-      kept.push_back(static_cast<std::uint32_t>(i));
+  const std::size_t k = params.min_neighbours + 1;
+  const float radius = static_cast<float>(params.radius);
+  std::vector<Neighbour> neighbours;
+  std::vector<char> keep(points_Bin.size(), 0);
+  std::size_t visited = 0;
+  for (const std::uint32_t i : grid.cell_order()) {  // cache-friendly order
+    if (visited++ % kStopPollInterval == 0) ThrowIfStopped(stop, "filter radius_outlier");
+    grid.Nearest(points_Bin[i], k, radius, &neighbours);
+    keep[i] = neighbours.size() == k ? 1 : 0;
+  }
+  kept.reserve(grid.size());
+  for (std::uint32_t i = 0; i < points_Bin.size(); ++i) {
+    if (keep[i] != 0) kept.push_back(i);
   }
   return kept;
 }

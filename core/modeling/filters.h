@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -109,6 +110,16 @@ struct FilterContext {
 std::vector<std::uint32_t> ApplyFilter(const FilterStep& step, const Points& points_Bin,
                                        const Points* normals, const FilterContext& context,
                                        std::uint64_t seed, const StopToken* stop = nullptr);
+
+/// The box a crop_box step keeps, in the bin frame, as float corners (the points' precision).
+/// @throws InvalidArgument when from_bin makes it empty (the message names the bin and the params).
+std::pair<Eigen::Vector3f, Eigen::Vector3f> CropBoxBounds(const CropBoxParams& params, const BinConfig& bin);
+
+/// True when p_Bin lies in the box [lo, hi] (inclusive); NaN fails every comparison.
+inline bool InCropBox(const Eigen::Vector3f& p_Bin, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+  return p_Bin.x() >= lo.x() && p_Bin.x() <= hi.x() && p_Bin.y() >= lo.y() && p_Bin.y() <= hi.y() &&
+         p_Bin.z() >= lo.z() && p_Bin.z() <= hi.z();
+}
 
 /// Checks a step's parameters. @throws InvalidArgument naming `key` and the bad value.
 void ValidateFilter(const FilterStep& step, const std::string& key);

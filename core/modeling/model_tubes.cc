@@ -5,8 +5,10 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <tuple>
 
 #include <spdlog/spdlog.h>
@@ -61,33 +63,57 @@ struct WorkingCloud {
 }  // namespace
 
 ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params, const StopToken* stop) {
-  if (input.points_Sensor == nullptr) throw InvalidArgument("cloud: no points given");
+  if (input.points_Sensor != nullptr && !input.xyz_Sensor.bytes.empty()) {
+    throw std::invalid_argument("ModelingInput: both points_Sensor and xyz_Sensor are set");
+  }
+  if (input.xyz_Sensor.bytes.size() % 12 != 0) {
+    throw InvalidArgument("cloud: " + std::to_string(input.xyz_Sensor.bytes.size()) +
+                          " bytes is not a multiple of 12 (packed float32 x, y, z per point)");
+  }
   params.Validate();
   const Clock::time_point t_start = Clock::now();
   ModelingResult result;
 
-  // 1. Prepare: units, NaN removal, bin frame.
+  // 1. Prepare, in one pass over the input: units, NaN removal, bin frame, the cloud-vs-cell
+  // evidence and a leading crop box (the rest of the filter chain then sees only the crop).
   Clock::time_point t0 = Clock::now();
-  PreparedCloud prepared = PrepareCloud(*input.points_Sensor, input.unit, input.X_BinSensor);
-  result.input_points = input.points_Sensor->size();
+  const FilterContext context{input.X_BinSensor, input.bin};
+  PrepareSpec spec;
+  spec.bin = input.bin;
+  spec.plausibility = params.plausibility;
+  const bool raw_surface = params.normals.search_surface == SearchSurface::kRaw;
+  spec.raw_region_Bin = raw_surface ? RawRegion::All() : input.raw_region_Bin;
+  std::size_t first_filter = 0;
+  if (!params.filters.empty()) {
+    if (const auto* crop = std::get_if<CropBoxParams>(&params.filters.front())) {
+      spec.crop_Bin = CropBoxBounds(*crop, input.bin);
+      first_filter = 1;
+    }
+  }
+  PreparedCloud prepared = input.points_Sensor != nullptr
+                               ? PrepareCloud(*input.points_Sensor, input.unit, input.X_BinSensor, spec, stop)
+                               : PrepareCloud(input.xyz_Sensor, input.unit, input.X_BinSensor, spec, stop);
+  result.input_points = prepared.input_points;
   result.dropped_non_finite = prepared.dropped_non_finite;
-  result.raw_Bin = std::move(prepared.points_Bin);
+  result.plausibility = prepared.plausibility;
+  result.raw_Bin = std::move(prepared.raw_Bin);
+  result.raw_region_Bin = spec.raw_region_Bin;
   result.counts.push_back({"input", result.input_points});
-  result.counts.push_back({"finite", result.raw_Bin.size()});
-  result.plausibility =
-      RequirePlausibleCloud(result.raw_Bin, input.bin, input.unit, input.X_BinSensor, params.plausibility);
+  result.counts.push_back({"finite", result.plausibility.points});
+  RequirePlausible(result.plausibility, input.bin, input.unit, input.X_BinSensor, params.plausibility);
+  WorkingCloud work;
+  work.cloud.points = std::move(prepared.working_Bin);
+  work.source_index = std::move(prepared.working_source_index);
+  if (first_filter == 1) result.counts.push_back({FilterName(params.filters.front()), work.cloud.size()});
   result.timings.push_back({"prepare", SecondsSince(t0)});
   ThrowIfStopped(stop, "prepare");
 
-  // 2. Filters, with normals estimated when first needed (or after the last filter).
-  const FilterContext context{input.X_BinSensor, input.bin};
+  // 2. The rest of the filters, with normals estimated when first needed (or after the last filter).
   const Eigen::Vector3f viewpoint_Bin = input.X_BinSensor.translation().cast<float>();
-  WorkingCloud work;
   double filter_seconds = 0.0, normal_seconds = 0.0;
   auto estimate_normals = [&]() {
     const Clock::time_point tn = Clock::now();
-    const Points& surface =
-        params.normals.search_surface == SearchSurface::kRaw ? result.raw_Bin : work.cloud.points;
+    const Points& surface = raw_surface ? result.raw_Bin : work.cloud.points;
     OrientedPoints oriented =
         EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop, params.threads);
     std::vector<std::uint32_t> valid;
@@ -102,14 +128,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     normal_seconds += SecondsSince(tn);
   };
 
-  work.cloud.points = result.raw_Bin;
-  if (prepared.source_index.empty()) {
-    work.source_index.resize(result.raw_Bin.size());
-    for (std::uint32_t i = 0; i < work.source_index.size(); ++i) work.source_index[i] = i;
-  } else {
-    work.source_index = std::move(prepared.source_index);
-  }
-  for (std::size_t i = 0; i < params.filters.size(); ++i) {
+  for (std::size_t i = first_filter; i < params.filters.size(); ++i) {
     const FilterStep& step = params.filters[i];
     if (FilterNeedsNormals(step) && !work.has_normals) estimate_normals();
     const Clock::time_point tf = Clock::now();

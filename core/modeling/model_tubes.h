@@ -8,18 +8,25 @@
 #include "core/common/stop_token.h"
 #include "core/common/types.h"
 #include "core/modeling/cloud_plausibility.h"
+#include "core/modeling/cloud_prepare.h"
 #include "core/modeling/modeling_params.h"
 
 namespace tubepick {
 
 struct ModelingInput {
-  /// The cloud as the scanner gives it: sensor optical frame, in `unit`.
+  /// The cloud as the scanner gives it: sensor optical frame, in `unit`. Exactly one of
+  /// points_Sensor and xyz_Sensor (the wire form, read in place) is set.
   const Points* points_Sensor = nullptr;
+  PackedXyz xyz_Sensor;
   LengthUnit unit = LengthUnit::kMetre;
   Eigen::Isometry3d X_BinSensor = SensorConfig::DefaultX_BinSensor();
   BinConfig bin;
   /// Drives every random choice: same cloud + seed ⇒ same tubes.
   std::uint64_t seed = 0;
+  /// ModelingResult::raw_Bin keeps the finite points in this region (default: all). PlanPick needs
+  /// those a finger box can reach (RawRegionForPlanning); modeling alone needs none
+  /// (RawRegion::None()), and every point kept is memory the call touches.
+  RawRegion raw_region_Bin;
 };
 
 struct StageTiming {
@@ -46,8 +53,10 @@ struct ModelingResult {
   std::vector<StageTiming> timings;
   double total_seconds = 0.0;
 
-  /// The finite input in the bin frame (for grasp collision checks and evaluation).
+  /// The finite input in the bin frame inside raw_region_Bin (for the grasp collision check; all of
+  /// it when the normals search the raw cloud).
   Points raw_Bin;
+  RawRegion raw_region_Bin;
   /// The filtered cloud (with normals) that was segmented.
   OrientedPoints filtered;
   /// Per filtered point: its index in the input cloud (ModelingInput::points_Sensor), so per-point
@@ -62,7 +71,7 @@ struct ModelingResult {
 /// Runs Algorithm 1: prepare → filters (+ normals) → region growing → cylinders → joining.
 /// @throws InvalidArgument for an empty / all-non-finite cloud or invalid parameters.
 /// @throws FailedPrecondition when the cloud in the bin frame does not look like the cell (wrong
-///         unit or sensor pose; see RequirePlausibleCloud and params.plausibility).
+///         unit or sensor pose; see RequirePlausible and params.plausibility).
 /// @throws Cancelled when `stop` fires (polled inside every stage).
 ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params,
                           const StopToken* stop = nullptr);

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -134,11 +135,32 @@ bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params) {
   return true;
 }
 
+RawRegion RawRegionForPlanning(const PlanningParams& params, const BinConfig& bin) {
+  if (!params.tool.check) return RawRegion::All();
+  constexpr double kSlack = 1e-3;
+  const ToolParams& tool = params.tool;
+  const GraspFilterParams& fingers = params.filters;
+  // How far a finger box may reach past the tool's pad, in x_Tcp and y_Tcp together (any yaw).
+  const double past_pad = std::max(0.0, 0.5 * (fingers.finger_width - tool.finger_size.x())) +
+                          std::max(0.0, fingers.finger_thickness - tool.finger_size.y());
+  RawRegion region;
+  region.min_z = tool.margin + tool.finger_tip_depth - fingers.finger_tip_depth - kSlack;
+  region.half_xy =
+      0.5 * bin.inner_size.head<2>() - Eigen::Vector2d::Constant(tool.margin - past_pad - kSlack);
+  region.any_xy_above_z = bin.inner_size.z() - kSlack;
+  return region;
+}
+
 PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, const PlanningParams& params,
                         TrajectoryEvaluator* evaluator, std::uint64_t seed, const StopToken* stop) {
   const Clock::time_point start = Clock::now();
   params.Validate();
   cell.Validate();
+  if (!modeling.raw_region_Bin.Covers(RawRegionForPlanning(params, cell.bin))) {
+    throw std::logic_error(
+        "PlanPick: modeling kept fewer raw points than the finger test needs (set "
+        "ModelingInput::raw_region_Bin to RawRegionForPlanning)");
+  }
   if (!(params.grasps.opening_width > 2.0 * cell.tube.radius)) {
     std::ostringstream s;
     s << "planning.grasps.opening_width: " << params.grasps.opening_width

@@ -91,6 +91,16 @@ struct PickPlanResult {
 /// cropped by modeling; the height threshold absorbs floor points a loose crop kept).
 bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params);
 
+/// The raw points PlanPick's finger test can meet (bin frame). A grasp reaches that test only after
+/// the tool-clearance test has kept its pads tool.margin above the floor and, below the wall top,
+/// tool.margin inside the walls; the finger boxes (grasp_filters.h) may reach past the pads by the
+/// difference of their sizes. So: z >= tool.margin + tool.finger_tip_depth −
+/// filters.finger_tip_depth, |x|, |y| within the inner half size − tool.margin + that difference,
+/// any x, y from the wall top up; 1 mm of slack on each bound. Everything when tool.check is off.
+/// Pass it as ModelingInput::raw_region_Bin: the floor and the walls (most of a scan) then never
+/// enter the finger test's index, and the plans are the same.
+RawRegion RawRegionForPlanning(const PlanningParams& params, const BinConfig& bin);
+
 /// Plans a pick (ARCHITECTURE.md "How a plan request flows", thesis §5.2.2–§5.2.4):
 /// 1. classify the modeled tubes (length filter, occlusion);
 /// 2. candidates in stages, stopping at the first stage that yields a viable grasp:
@@ -109,7 +119,9 @@ bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params);
 /// @throws InvalidArgument for invalid params / cell (naming the key), a tube without cylinders
 ///         or non-finite geometry, or an opening width not larger than the tube diameter.
 /// @throws Cancelled when `stop` fires (also from the evaluator).
-/// @throws std::logic_error when the evaluator returns the wrong number of outcomes.
+/// @throws std::logic_error when the evaluator returns the wrong number of outcomes, or when
+///         modeling kept fewer raw points than the finger test needs (modeling.raw_region_Bin does
+///         not cover RawRegionForPlanning).
 PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, const PlanningParams& params,
                         TrajectoryEvaluator* evaluator, std::uint64_t seed, const StopToken* stop = nullptr);
 

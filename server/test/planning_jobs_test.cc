@@ -12,6 +12,7 @@
 #include "core/common/errors.h"
 #include "core/testing/sanitizer_build.h"
 #include "core/testing/synthetic_cloud.h"
+#include "wire/packed_cloud.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::server {
@@ -95,7 +96,8 @@ void ExpectOrderedByCost(const v1::PlanPickResponse& r) {
 
 TEST(RunModelTubes, FindsTheThreeTubes) {
   const PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(Request(ThreeTubesCloud(), 5), defaults);
+  const v1::PlanPickRequest job_request = Request(ThreeTubesCloud(), 5);
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   const v1::ModelTubesResponse r = RunModelTubes(job, 1, nullptr);
   ASSERT_EQ(r.tubes_size(), 3);
   for (const v1::Tube& t : r.tubes()) {
@@ -103,7 +105,7 @@ TEST(RunModelTubes, FindsTheThreeTubes) {
     ASSERT_GE(t.cylinders_size(), 1);
     EXPECT_NEAR(t.cylinders(0).radius(), kR, 0.001);
   }
-  EXPECT_EQ(r.input_points(), job.points_Sensor.size());
+  EXPECT_EQ(r.input_points(), job.xyz_Sensor.size() / 12);
   EXPECT_NEAR(r.max_height(), 2.0 * kR, 0.004);
   EXPECT_EQ(r.profile(), "fast");
   EXPECT_EQ(r.seed(), 5u);
@@ -113,8 +115,9 @@ TEST(RunModelTubes, FindsTheThreeTubes) {
 
 TEST(RunModelTubes, MillimetreCloudGivesTheSameTubes) {
   const PlanningDefaults defaults;
-  const PlanningJob metres = ValidatePlanPick(Request(ThreeTubesCloud()), defaults);
-  Points scaled = metres.points_Sensor;
+  const v1::PlanPickRequest metres_request = Request(ThreeTubesCloud());
+  const PlanningJob metres = ValidatePlanPick(metres_request, defaults);
+  Points scaled = UnpackXyz(metres.xyz_Sensor);
   for (Eigen::Vector3f& p : scaled) p *= 1000.0f;
   v1::PlanPickRequest request = Request(Encode(scaled));
   request.mutable_cloud()->set_unit(v1::LENGTH_UNIT_MILLIMETRE);
@@ -126,14 +129,15 @@ TEST(RunModelTubes, MillimetreCloudGivesTheSameTubes) {
 
 TEST(RunModelTubes, AllNonFiniteCloudIsACallerMistake) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  const PlanningJob job =
-      ValidatePlanPick(Request(Encode(Points(100, Eigen::Vector3f(nan, nan, nan)))), PlanningDefaults{});
+  const v1::PlanPickRequest request = Request(Encode(Points(100, Eigen::Vector3f(nan, nan, nan))));
+  const PlanningJob job = ValidatePlanPick(request, PlanningDefaults{});
   EXPECT_THROW(RunModelTubes(job, 1, nullptr), InvalidArgument);
 }
 
 TEST(RunPlanPick, UnoccludedTubesNeedNoSimulation) {
   const PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(Request(ThreeTubesCloud()), defaults);
+  const v1::PlanPickRequest job_request = Request(ThreeTubesCloud());
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   const v1::PlanPickResponse r = RunPlanPick(job, defaults, 1, nullptr);
   EXPECT_FALSE(r.used_simulation());
   EXPECT_FALSE(r.bin_empty());
@@ -195,7 +199,8 @@ TEST(RunPlanPick, WovenTubesAreSimulatedAndRankedByCost) {
 
 TEST(RunPlanPick, SameSeedGivesIdenticalBytesWhateverTheThreads) {
   const PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(Request(WeaveCloud(), 8), defaults);
+  const v1::PlanPickRequest job_request = Request(WeaveCloud(), 8);
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   const std::string a = WithoutTimings(RunPlanPick(job, defaults, 1, nullptr)).SerializeAsString();
   const std::string b = WithoutTimings(RunPlanPick(job, defaults, 2, nullptr)).SerializeAsString();
   EXPECT_GT(a.size(), 1000u);
@@ -219,7 +224,8 @@ TEST(RunPlanPick, MaxPlansKeepsTheBestOnes) {
 
 TEST(RunPlanPick, StoppedTokenCancels) {
   const PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(Request(ThreeTubesCloud()), defaults);
+  const v1::PlanPickRequest job_request = Request(ThreeTubesCloud());
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   StopToken stopped;
   stopped.RequestStop();
   try {
@@ -240,7 +246,8 @@ TEST(RunPlanPick, StoppedTokenCancels) {
 
 TEST(RunPlanPick, StopDuringModelingEndsTheCallPromptly) {
   const PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(Request(WeaveCloud()), defaults);
+  const v1::PlanPickRequest job_request = Request(WeaveCloud());
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   StopToken token;
   std::chrono::steady_clock::time_point stopped_at;
   std::thread stopper([&] {
@@ -262,7 +269,8 @@ TEST(RunPlanPick, StopDuringSimulationEndsTheCallPromptly) {
   // is stopped long before: the slower the gripper, the surer the stop finds it simulating.
   PlanningDefaults defaults;
   defaults.simulation.gripper_speed = 0.0002;
-  const PlanningJob job = ValidatePlanPick(Request(WeaveCloud()), defaults);
+  const v1::PlanPickRequest job_request = Request(WeaveCloud());
+  const PlanningJob job = ValidatePlanPick(job_request, defaults);
   const auto model_start = std::chrono::steady_clock::now();
   (void)RunModelTubes(job, 1, nullptr);
   const auto modeling = std::chrono::steady_clock::now() - model_start;

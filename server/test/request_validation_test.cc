@@ -12,6 +12,7 @@
 
 #include "core/common/errors.h"
 #include "core/testing/error_of.h"
+#include "wire/packed_cloud.h"
 
 namespace tubepick::server {
 namespace {
@@ -173,30 +174,24 @@ TEST(ValidatePlanPick, TubeMustFitTheGripperOpening) {
   EXPECT_NO_THROW(ValidateModelTubes(model, defaults));
 }
 
-TEST(DecodeCloud, LittleEndianFloatTriples) {
+TEST(CheckCloudBytes, ReturnsTheBytesInPlace) {
   const std::vector<Eigen::Vector3f> points = {{1.5f, -2.25f, 1e-3f}, {0.f, 3.f, -7.f}};
   // Bytes of 1.5f little-endian: 00 00 C0 3F.
   const std::string bytes = Encode(points);
   EXPECT_EQ(bytes.substr(0, 4), std::string("\x00\x00\xC0\x3F", 4));
-  const Points decoded = DecodeCloud(bytes, 10, "cloud.xyz");
-  ASSERT_EQ(decoded.size(), 2u);
-  EXPECT_EQ(decoded[0], points[0]);
-  EXPECT_EQ(decoded[1], points[1]);
-  EXPECT_EQ(DecodeCloud(bytes, 2, "cloud.xyz").size(), 2u);  // the limit is inclusive
-}
-
-TEST(DecodeCloud, KeepsNonFinitePointsForModelingToDrop) {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const Points decoded = DecodeCloud(Encode({{nan, nan, nan}, {0.f, 0.f, 1.f}}), 10, "cloud.xyz");
-  ASSERT_EQ(decoded.size(), 2u);
-  EXPECT_TRUE(std::isnan(decoded[0].x()));
+  const std::string_view checked = CheckCloudBytes(bytes, 10, "cloud.xyz");
+  EXPECT_EQ(checked.data(), bytes.data());  // not copied
+  EXPECT_EQ(checked.size(), 24u);
+  EXPECT_EQ(CheckCloudBytes(bytes, 2, "cloud.xyz").size(), 24u);  // the limit is inclusive
+  EXPECT_THROW(CheckCloudBytes(bytes, 1, "cloud.xyz"), TooLarge);
 }
 
 TEST(ValidatePlanPick, CopiesEveryField) {
   PlanningDefaults defaults;
-  const PlanningJob job = ValidatePlanPick(ValidRequest(), defaults);
-  ASSERT_EQ(job.points_Sensor.size(), 3u);
-  EXPECT_EQ(job.points_Sensor[1], Eigen::Vector3f(0.1f, -0.2f, 1.05f));
+  const v1::PlanPickRequest request = ValidRequest();  // the job views its cloud bytes
+  const PlanningJob job = ValidatePlanPick(request, defaults);
+  ASSERT_EQ(job.xyz_Sensor.size(), 36u);
+  EXPECT_EQ(UnpackXyz(job.xyz_Sensor)[1], Eigen::Vector3f(0.1f, -0.2f, 1.05f));
   EXPECT_EQ(job.cell.bin.inner_size, Eigen::Vector3d(0.6, 0.4, 0.25));
   EXPECT_NEAR(job.cell.sensor.X_BinSensor.translation().z(), 1.2, 1e-15);
   EXPECT_NEAR((job.cell.sensor.X_BinSensor.linear() * Eigen::Vector3d::UnitZ()).z(), -1.0, 1e-12);
@@ -264,7 +259,8 @@ TEST(ValidatePlanPickStream, HeaderCloudMustBeEmptyAndFieldsArePrefixed) {
   const std::string bytes = request.cloud().xyz();
   request.mutable_cloud()->clear_xyz();
   const PlanningJob job = ValidatePlanPick(request, bytes, defaults);
-  EXPECT_EQ(job.points_Sensor.size(), 3u);
+  EXPECT_EQ(job.xyz_Sensor.size(), 36u);
+  EXPECT_EQ(job.xyz_Sensor.data(), bytes.data());
   EXPECT_EQ(job.seed, 17u);
 
   request.mutable_cell()->set_tube_radius(-1.0);

@@ -198,8 +198,8 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
   out.tube_count = static_cast<std::uint32_t>(tubes_Bin.size());
   out.input_points = points_Sensor.size();
 
-  const ModelingResult result =
-      ModelTubes(MakeModelingInput(points_Sensor, unit, cell, o.common.seed), params.modeling);
+  const ModelingResult result = ModelTubes(
+      MakeModelingInput(points_Sensor, unit, cell, o.common.seed, RawRegion::None()), params.modeling);
   out.evaluation = EvaluateScene(result, labels, out.tube_count, eval_params);
   out.snapshot = MakeSnapshot(result, labels, tubes_Bin, eval_params, cell.bin);
   return out;

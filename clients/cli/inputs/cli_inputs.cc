@@ -55,8 +55,9 @@ CloudInput LoadCloudInput(const InputOptions& o, const CellConfig& cell) {
 }
 
 ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, const CellConfig& cell,
-                                std::uint64_t seed) {
+                                std::uint64_t seed, const RawRegion& raw_region_Bin) {
   ModelingInput input;
+  input.raw_region_Bin = raw_region_Bin;
   input.points_Sensor = &points_Sensor;
   input.unit = unit;
   input.X_BinSensor = cell.sensor.X_BinSensor;

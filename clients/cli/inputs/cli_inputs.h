@@ -43,9 +43,10 @@ struct CloudInput {
 CloudInput LoadCloudInput(const InputOptions& options, const CellConfig& cell);
 
 /// The modeling input for a cloud in the sensor frame, in `unit`, seen in `cell` (it points into
-/// `points_Sensor`, which must outlive it).
+/// `points_Sensor`, which must outlive it), keeping the raw points in raw_region_Bin
+/// (ModelingInput::raw_region_Bin: RawRegionForPlanning before PlanPick, None for modeling alone).
 ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, const CellConfig& cell,
-                                std::uint64_t seed);
+                                std::uint64_t seed, const RawRegion& raw_region_Bin);
 
 /// The cell from --cell, or the embedded default (ARCHITECTURE.md's example).
 CellConfig LoadCell(const CommonOptions& options);

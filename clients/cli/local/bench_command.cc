@@ -67,7 +67,7 @@ void RunBench(const BenchOptions& o) {
   fmt::print("bench modeling: {} ({} points), {} repetitions after 1 warm-up, {} hardware threads\n", source,
              points_Sensor.size(), o.repetitions, std::thread::hardware_concurrency());
 
-  const ModelingInput input = MakeModelingInput(points_Sensor, unit, cell, o.common.seed);
+  const ModelingInput input = MakeModelingInput(points_Sensor, unit, cell, o.common.seed, RawRegion::None());
 
   std::vector<ProfileFigures> figures;
   for (const std::string& profile : o.profiles) {
@@ -148,7 +148,8 @@ void RunPlanBench(const PlanBenchOptions& o) {
   const Params params = LoadParamsFor(o.common);
   BuiltInScene scene = MakeBuiltInScene(cell, o.tubes, o.common.seed);
   const ModelingInput input =
-      MakeModelingInput(scene.points_Sensor, LengthUnit::kMetre, cell, o.common.seed);  // scanner: metres
+      MakeModelingInput(scene.points_Sensor, LengthUnit::kMetre, cell, o.common.seed,  // scanner: metres
+                        RawRegionForPlanning(params.planning, cell.bin));
   fmt::print("bench plan: {} ({} points), profile {}, {} repetitions after 1 warm-up\n", scene.description,
              scene.points_Sensor.size(), o.common.profile, o.repetitions);
 
@@ -204,7 +205,7 @@ void RunPlanBench(const PlanBenchOptions& o) {
 
 }  // namespace
 
-void AddBenchCommand(CLI::App& app) {
+CLI::App* AddBenchCommand(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks that print figures (medians, ratios, memory)");
   bench->require_subcommand(1);
   auto o = std::make_shared<BenchOptions>();
@@ -234,6 +235,7 @@ void AddBenchCommand(CLI::App& app) {
       ->capture_default_str();
   plan->add_option("--trajectories", p->trajectories, "Trajectories to simulate")->capture_default_str();
   plan->callback([p] { RunPlanBench(*p); });
+  return bench;
 }
 
 }  // namespace tubepick::cli

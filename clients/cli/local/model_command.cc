@@ -45,7 +45,8 @@ void Run(const ModelOptions& o) {
   const Params params = LoadParamsFor(common);
 
   const CloudInput cloud = LoadCloudInput(o.input, cell);
-  const ModelingInput input = MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, o.input.common.seed);
+  const ModelingInput input =
+      MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, o.input.common.seed, RawRegion::None());
   const ModelingResult result = ModelTubes(input, params.modeling);
 
   PrintSummary(result, cloud.source + fmt::format(", profile {}, seed {}", common.profile, common.seed));

@@ -42,7 +42,8 @@ void Run(const PlanOptions& o) {
   const CellConfig cell = LoadCell(common);
   const Params params = LoadParamsFor(common);
   const CloudInput cloud = LoadCloudInput(o.input, cell);
-  const ModelingInput input = MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, common.seed);
+  const ModelingInput input = MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, common.seed,
+                                                RawRegionForPlanning(params.planning, cell.bin));
   const ModelingResult modeling = ModelTubes(input, params.modeling);
 
   physics::BulletTrajectoryEvaluator evaluator(physics::SimParamsForCell(

@@ -47,8 +47,7 @@ Points Scaled(const Points& points, float factor) {
 // The cloud as ModelTubes checks it: `points_Sensor` read in `unit` and put in the bin frame with
 // the cell's (possibly wrong) X_BinSensor.
 CloudPlausibility Check(const Points& points_Sensor, LengthUnit unit, const Eigen::Isometry3d& X_BinSensor) {
-  return CheckCloudAgainstCell(PrepareCloud(points_Sensor, unit, X_BinSensor).points_Bin, BinConfig{},
-                               PlausibilityParams{});
+  return PrepareCloud(points_Sensor, unit, X_BinSensor, PrepareSpec{}).plausibility;
 }
 
 // The FailedPrecondition message of ModelTubes, or "" when it did not throw one.
@@ -167,12 +166,11 @@ TEST(CloudPlausibility, FloorNotSeenIsAnErrorEvenInsideTheBin) {
   const CloudPlausibility e = CheckCloudAgainstCell(points_Bin, BinConfig{}, PlausibilityParams{});
   EXPECT_TRUE(e.enough_inside);
   EXPECT_FALSE(e.floor_seen);
-  EXPECT_THROW(
-      RequirePlausibleCloud(points_Bin, BinConfig{}, LengthUnit::kMetre, kPose, PlausibilityParams{}),
-      FailedPrecondition);
+  EXPECT_THROW(RequirePlausible(e, BinConfig{}, LengthUnit::kMetre, kPose, PlausibilityParams{}),
+               FailedPrecondition);
   PlausibilityParams off;
   off.check = false;  // evidence only
-  EXPECT_FALSE(RequirePlausibleCloud(points_Bin, BinConfig{}, LengthUnit::kMetre, kPose, off).floor_seen);
+  EXPECT_NO_THROW(RequirePlausible(e, BinConfig{}, LengthUnit::kMetre, kPose, off));
 }
 
 TEST(CloudPlausibility, CheckOffModelsTheCloudAsBefore) {

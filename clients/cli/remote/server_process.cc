@@ -1,4 +1,4 @@
-#include "clients/cli/cell/server_process.h"
+#include "clients/cli/remote/server_process.h"
 
 #include <fcntl.h>
 #include <poll.h>
