@@ -44,22 +44,40 @@ std::vector<std::uint32_t> RadiusOutlierFilter(const RadiusOutlierParams& params
                                                const StopToken* stop) {
   if (params.min_neighbours == 0) return FiniteIndices(points_Bin);
   // A hash grid of cell size = radius (not PCL's FLANN tree, whose every query opens an OpenMP
-  // region: 40 k queries cost more in thread wake-ups than in searching).
-  const NeighbourGrid grid(points_Bin, static_cast<float>(params.radius));
+  // region: 40 k queries cost more in thread wake-ups than in searching). A query's 3×3×3 block
+  // then holds every point within the radius, so counting there answers it.
+  const float radius = static_cast<float>(params.radius);
+  const NeighbourGrid grid(points_Bin, radius);
   std::vector<std::uint32_t> kept;
   if (grid.size() <= params.min_neighbours) return kept;  // nobody can have enough neighbours
   // The point itself is its own nearest neighbour: it has min_neighbours others within the radius
-  // exactly when its (min_neighbours + 1)-th nearest point is within the radius.
+  // exactly when min_neighbours + 1 points (itself included) are.
   const std::size_t k = params.min_neighbours + 1;
-  const float radius = static_cast<float>(params.radius);
-  std::vector<Neighbour> neighbours;
+  const float r2 = radius * radius;  // as NeighbourGrid::Nearest rounds it
+  // Rounding may put a point just past a cell face: far from the block's faces the block is exact,
+  // nearer than this the ring search decides.
+  const float safe_bound = radius * (1.0f + 1e-4f);
   std::vector<char> keep(points_Bin.size(), 0);
-  std::size_t visited = 0;
-  for (const std::uint32_t i : grid.cell_order()) {  // cache-friendly order
-    if (visited++ % kStopPollInterval == 0) ThrowIfStopped(stop, "filter radius_outlier");
-    grid.Nearest(points_Bin[i], k, radius, &neighbours);
-    keep[i] = neighbours.size() == k ? 1 : 0;
-  }
+  auto count = [&](const NeighbourGrid::Block& block, const std::uint32_t* begin, const std::uint32_t* end,
+                   std::vector<Neighbour>& neighbours) {
+    for (const std::uint32_t* it = begin; it != end; ++it) {
+      const Eigen::Vector3f& q = points_Bin[*it];
+      if (!q.allFinite()) continue;
+      if (block.Bound(q) < safe_bound) {
+        grid.Nearest(q, k, radius, &neighbours);
+        keep[*it] = neighbours.size() == k ? 1 : 0;
+        continue;
+      }
+      std::size_t within = 0;
+      for (std::size_t i = 0; i < block.size() && within < k; ++i) {
+        const float dx = block.x[i] - q.x(), dy = block.y[i] - q.y(), dz = block.z[i] - q.z();
+        within += dx * dx + dy * dy + dz * dz <= r2 ? 1 : 0;  // Nearest()'s rounding
+      }
+      keep[*it] = within >= k ? 1 : 0;
+    }
+  };
+  grid.ForEachQueryBlock<std::vector<Neighbour>>(points_Bin, 1, stop, count);
+  ThrowIfStopped(stop, "filter radius_outlier");
   kept.reserve(grid.size());
   for (std::uint32_t i = 0; i < points_Bin.size(); ++i) {
     if (keep[i] != 0) kept.push_back(i);

@@ -302,7 +302,9 @@ void RunServiceBench(ServiceBenchOptions o) {
   const std::vector<BenchCloud> clouds = LoadClouds(o);
   std::string config_path;
   std::unique_ptr<ServerProcess> server = StartServer(o, &config_path);
-  const auto channel = MakeChannel(ChannelOptions{server->address()});
+  ChannelOptions channel_options;
+  channel_options.target = server->address();
+  const auto channel = MakeChannel(channel_options);
   fmt::print(
       "bench service: {} clouds ({} points first), tubepick-server pid {} on {}: {} workers x {} threads "
       "per call, {} cores; in-process on {} threads; no warm-up\n",
