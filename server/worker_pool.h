@@ -1,7 +1,6 @@
 #pragma once
 
 #include <atomic>
-#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -33,11 +32,8 @@ class WorkerPool {
   /// on with the next job instead of terminating the process.
   using Job = std::function<void()>;
 
-  /// `workers` ≥ 1 threads start at once. Once no job has run or waited for `idle_trim_delay`, one
-  /// worker gives the heap's free pages back to the kernel (malloc_trim): an idle server shrinks,
-  /// a busy one keeps reusing its pages instead of faulting them in again for every call.
-  WorkerPool(std::uint32_t workers, std::uint32_t queue_capacity,
-             std::chrono::milliseconds idle_trim_delay = std::chrono::seconds(1));
+  /// `workers` ≥ 1 threads start at once.
+  WorkerPool(std::uint32_t workers, std::uint32_t queue_capacity);
   ~WorkerPool();  // Stop()
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -52,8 +48,6 @@ class WorkerPool {
   PoolLoad load() const;
   std::uint32_t workers() const { return static_cast<std::uint32_t>(threads_.size()); }
   std::uint32_t queue_capacity() const { return queue_capacity_; }
-  /// How often the idle pool has trimmed the heap.
-  std::uint64_t idle_trims() const { return idle_trims_.load(); }
   /// Jobs that threw although jobs must not (each one logged as an error).
   std::uint64_t escaped_exceptions() const { return escaped_exceptions_.load(); }
 
@@ -62,8 +56,6 @@ class WorkerPool {
 
  private:
   void WorkerLoop();
-  /// Called idle, with `lock` held: trims once no job came for idle_trim_delay_ (false: a job came).
-  void TrimWhenIdle(std::unique_lock<std::mutex>& lock);
   void RunGuarded(const Job& job);
   bool HasRoomLocked() const;
 
@@ -73,10 +65,6 @@ class WorkerPool {
   std::deque<Job> queue_;
   std::uint32_t busy_ = 0;
   bool stopping_ = false;
-  const std::chrono::milliseconds idle_trim_delay_;
-  /// A job finished since the last trim.
-  bool trim_pending_ = false;
-  std::atomic<std::uint64_t> idle_trims_{0};
   std::atomic<std::uint64_t> escaped_exceptions_{0};
   std::mutex join_mu_;
   std::vector<std::thread> threads_;

@@ -1,6 +1,5 @@
 // Planning on generated scenes: physics drop -> virtual scan -> modeling -> planning with the
 // Bullet trajectory evaluator, as the service will run it.
-#include <bit>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -14,6 +13,7 @@
 #include "physics/scene_generator.h"
 #include "physics/trajectory_simulator.h"
 #include "physics/virtual_scanner.h"
+#include "wire/packed_cloud.h"
 
 namespace tubepick {
 namespace {
@@ -89,18 +89,6 @@ TEST(PlanPipeline, SameSeedSamePlans) {
   }
 }
 
-// Little-endian float32 x, y, z per point, as PlanPickRequest.cloud.xyz carries them.
-std::string PackedLittleEndian(const Points& points) {
-  std::string bytes(points.size() * 12, '\0');
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      const auto bits = std::bit_cast<std::uint32_t>(points[i][k]);
-      for (int b = 0; b < 4; ++b) bytes[12 * i + 4 * k + b] = static_cast<char>((bits >> (8 * b)) & 0xffu);
-    }
-  }
-  return bytes;
-}
-
 void ExpectSamePlans(const PickPlanResult& a, const PickPlanResult& b) {
   ASSERT_EQ(a.plans.size(), b.plans.size());
   for (std::size_t i = 0; i < a.plans.size(); ++i) {
@@ -130,7 +118,7 @@ TEST(PlanPipeline, ServicePathPlansExactlyAsTheReferencePath) {
     reference.X_BinSensor = cell.sensor.X_BinSensor;
     reference.bin = cell.bin;
     reference.seed = seed;
-    const std::string bytes = PackedLittleEndian(scan.points_Sensor);
+    const std::string bytes = PackXyz(scan.points_Sensor);  // as PlanPickRequest.cloud.xyz
     ModelingInput service = reference;
     service.points_Sensor = nullptr;
     service.xyz_Sensor = PackedXyz{bytes};

@@ -137,24 +137,6 @@ TEST(WorkerPool, RunsJobsInParallelOnItsWorkers) {
   EXPECT_EQ(pool.load().busy, 0u);
 }
 
-TEST(WorkerPool, TrimsTheHeapOnceIdleNotAfterEveryCall) {
-  WorkerPool pool(2, 4, std::chrono::milliseconds(200));
-  EXPECT_EQ(pool.idle_trims(), 0u);
-  // Calls back to back (each within the idle delay of the last): no trim between them.
-  for (int i = 0; i < 5; ++i) {
-    std::promise<void> done;
-    ASSERT_EQ(pool.TrySubmit([&] { done.set_value(); }), WorkerPool::Admission::kAdmitted);
-    done.get_future().wait();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  EXPECT_EQ(pool.idle_trims(), 0u);
-  // Idle for the delay: one trim, and no further one while nothing runs.
-  ASSERT_TRUE(service_test::WaitFor([&] { return pool.idle_trims() == 1u; }, std::chrono::seconds(5)));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  EXPECT_EQ(pool.idle_trims(), 1u);
-  pool.Stop();
-}
-
 // --- Metrics ---------------------------------------------------------------------------------------
 
 TEST(Metrics, HistogramBucketsAreCumulative) {
