@@ -25,7 +25,7 @@ if [ "$mode" = runtime ]; then
     libgrpc++1.51 libprotobuf32
     libpcl-common1.13 libpcl-kdtree1.13
     libbullet3.24
-    libspdlog1.10 libfmt9 libyaml-cpp0.7 libmodbus5 libcurl4 libgomp1 libssl3
+    libspdlog1.10 libfmt9 libyaml-cpp0.7 libmodbus5 libcurl4 libgomp1 libssl3 libjemalloc2
   )
 else
   packages=(
@@ -35,6 +35,7 @@ else
     libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
     libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
     libmodbus-dev libcurl4-openssl-dev libgtest-dev libgmock-dev libbenchmark-dev
+    libjemalloc-dev
     openssl curl
     # deploy/ci/sanitizers.sh and fuzz.sh: clang with its sanitizer and libFuzzer runtimes, its
     # OpenMP, and llvm-symbolizer for the stack traces.

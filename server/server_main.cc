@@ -77,13 +77,26 @@ int Serve(const tubepick::server::ServerConfig& config) {
 
 }  // namespace
 
+#ifdef TUBEPICK_WITH_JEMALLOC
+// jemalloc's options (MALLOC_CONF overrides them). A call's big buffers — the request's cloud bytes,
+// 27.6 MB at 2.3 M points, above all — stay in the normal arenas, where the next call reuses their pages
+// and the background thread purges what has been unused for ~10 s (dirty and muzzy decay); jemalloc's
+// default puts blocks of 8 MiB or more in an arena that purges them at once, so every call would fault
+// them in afresh (about 10 µs a page on a paravirtual VM: half the call). The CI soak holds RSS flat.
+extern "C" {
+const char* malloc_conf = "oversize_threshold:0,background_thread:true";
+}
+#endif
+
 int main(int argc, char** argv) {
-  // Flat memory under load. glibc raises its mmap threshold to the size of the largest block freed
-  // (a 28 MB cloud), after which cloud-sized buffers come from the heap arenas and fragment them: a
-  // 10-minute soak at concurrency 4 crept +18 % in RSS. A fixed threshold (which also disables the
-  // dynamic one) keeps every buffer of 1 MiB or more in its own mapping, returned to the kernel on free;
-  // the workers trim the arenas after each call (WorkerPool).
+#ifndef TUBEPICK_WITH_JEMALLOC
+  // glibc (sanitizer builds): flat memory under load. glibc raises its mmap threshold to the size of
+  // the largest block freed (a 28 MB cloud), after which cloud-sized buffers come from the heap arenas
+  // and fragment them: a 10-minute soak at concurrency 4 crept +18 % in RSS. A fixed threshold (which
+  // also disables the dynamic one) keeps every buffer of 1 MiB or more in its own mapping, returned to
+  // the kernel on free; the workers trim the arenas after each call (WorkerPool).
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
   CLI::App app{"tubepick-server: the gRPC bin-picking planning service (tubepick.v1.PickPlannerService)"};
   Flags flags;
   app.add_option("--config", flags.config_file,
