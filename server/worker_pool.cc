@@ -1,5 +1,6 @@
 #include "server/worker_pool.h"
 
+#include <dlfcn.h>
 #include <malloc.h>
 
 #include <spdlog/spdlog.h>
@@ -9,6 +10,15 @@
 #include <utility>
 
 namespace tubepick::server {
+namespace {
+
+// True unless another allocator (jemalloc: it exports mallctl) replaced glibc's malloc.
+bool GlibcHeap() {
+  static const bool glibc = ::dlsym(RTLD_DEFAULT, "mallctl") == nullptr;
+  return glibc;
+}
+
+}  // namespace
 
 WorkerPool::WorkerPool(std::uint32_t workers, std::uint32_t queue_capacity)
     : queue_capacity_(queue_capacity) {
@@ -61,10 +71,10 @@ void WorkerPool::WorkerLoop() {
     RunGuarded(job);
     job = nullptr;  // destroy captures outside the lock
 #ifdef __GLIBC__
-    // Give the freed pages of this call back to the kernel (heap tops and whole free pages inside
-    // the arenas) so the resident set tracks the calls in flight, not the history: a few ms against
-    // calls of 0.1-1 s.
-    malloc_trim(0);
+    // With glibc's allocator (sanitizer builds), give the freed pages of this call back to the kernel
+    // (heap tops and whole free pages inside the arenas) so the resident set tracks the calls in
+    // flight, not the history. tubepick-server itself runs on jemalloc, which purges on its own.
+    if (GlibcHeap()) malloc_trim(0);
 #endif
     lock.lock();
     --busy_;
