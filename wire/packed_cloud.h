@@ -12,7 +12,8 @@ namespace tubepick {
 std::string PackXyz(const Points& points);
 
 /// The inverse of PackXyz. @pre xyz.size() is a multiple of 12 (the server checks and names the field
-/// first; see server/request_validation.h DecodeCloud).
+/// first; see server/request_validation.h CheckCloudBytes). The server itself never decodes: modeling
+/// reads the bytes in place (core/modeling/cloud_prepare.h PackedXyz).
 Points UnpackXyz(std::string_view xyz);
 
 }  // namespace tubepick
