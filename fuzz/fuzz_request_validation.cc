@@ -34,7 +34,7 @@ void Check(bool condition) {
 }
 
 void CheckJob(const server::PlanningJob& job, std::size_t xyz_bytes) {
-  Check(job.points_Sensor.size() * 12 == xyz_bytes);
+  Check(job.xyz_Sensor.size() == xyz_bytes && xyz_bytes % 12 == 0);
   Check(Defaults().profiles.count(job.profile) == 1);
   job.cell.Validate();  // validation promises a cell planning accepts: throwing here aborts below
 }
