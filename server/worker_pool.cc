@@ -12,10 +12,21 @@
 namespace tubepick::server {
 namespace {
 
-// True unless another allocator (jemalloc: it exports mallctl) replaced glibc's malloc.
+// True when glibc's malloc serves this process: not jemalloc (it exports mallctl), not a sanitizer's
+// allocator. Under a sanitizer glibc's arenas are never initialised, and two workers trimming them at
+// once for the first time crash (seen under TSan).
 bool GlibcHeap() {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return false;
+#else
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+  return false;
+#endif
+#endif
   static const bool glibc = ::dlsym(RTLD_DEFAULT, "mallctl") == nullptr;
   return glibc;
+#endif
 }
 
 }  // namespace
@@ -71,9 +82,10 @@ void WorkerPool::WorkerLoop() {
     RunGuarded(job);
     job = nullptr;  // destroy captures outside the lock
 #ifdef __GLIBC__
-    // With glibc's allocator (sanitizer builds), give the freed pages of this call back to the kernel
-    // (heap tops and whole free pages inside the arenas) so the resident set tracks the calls in
-    // flight, not the history. tubepick-server itself runs on jemalloc, which purges on its own.
+    // With glibc's allocator (tests, or a server built without jemalloc), give the freed pages of this
+    // call back to the kernel (heap tops and whole free pages inside the arenas) so the resident set
+    // tracks the calls in flight, not the history. tubepick-server runs on jemalloc, which purges on
+    // its own.
     if (GlibcHeap()) malloc_trim(0);
 #endif
     lock.lock();
