@@ -1,5 +1,7 @@
 #include "wire/packed_cloud.h"
 
+#include "core/modeling/cloud_prepare.h"
+
 #include <bit>
 #include <cassert>
 #include <cstdint>
@@ -26,19 +28,12 @@ std::string PackXyz(const Points& points) {
 
 Points UnpackXyz(std::string_view xyz) {
   assert(xyz.size() % 12 == 0);
-  const std::size_t count = xyz.size() / 12;
-  Points points(count);
+  const PackedXyz packed{xyz};
+  Points points(packed.size());
   if constexpr (std::endian::native == std::endian::little) {
-    if (count > 0) std::memcpy(static_cast<void*>(points.data()), xyz.data(), count * 12);
+    if (!points.empty()) std::memcpy(static_cast<void*>(points.data()), xyz.data(), xyz.size());
   } else {
-    for (std::size_t i = 0; i < count; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        std::uint32_t bits = 0;
-        for (int b = 0; b < 4; ++b)
-          bits |= static_cast<std::uint32_t>(static_cast<unsigned char>(xyz[12 * i + 4 * k + b])) << (8 * b);
-        points[i][k] = std::bit_cast<float>(bits);
-      }
-    }
+    for (std::size_t i = 0; i < points.size(); ++i) points[i] = packed.Point(i);
   }
   return points;
 }

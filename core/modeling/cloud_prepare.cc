@@ -14,21 +14,6 @@ namespace {
 // Points between two polls of the stop token.
 constexpr std::size_t kStopPollInterval = 1 << 16;
 
-Eigen::Vector3f ReadPacked(const char* bytes) {
-  Eigen::Vector3f p;
-  if constexpr (std::endian::native == std::endian::little) {
-    std::memcpy(p.data(), bytes, 12);
-  } else {
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t bits = 0;
-      for (int b = 0; b < 4; ++b)
-        bits |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[4 * k + b])) << (8 * b);
-      p[k] = std::bit_cast<float>(bits);
-    }
-  }
-  return p;
-}
-
 // The pass itself; `point(i)` reads input point i in the sensor frame and unit.
 template <typename ReadPoint>
 PreparedCloud Prepare(std::size_t count, ReadPoint point, LengthUnit unit,
@@ -47,8 +32,6 @@ PreparedCloud Prepare(std::size_t count, ReadPoint point, LengthUnit unit,
   // In float like the points (±∞ stay infinite).
   const RawRegion& raw = spec.raw_region_Bin;
   const bool keep_all_raw = raw.KeepsAll();
-  const bool keep_no_raw = raw.min_z == std::numeric_limits<double>::infinity() &&
-                           raw.any_xy_above_z == std::numeric_limits<double>::infinity();
   const float raw_min_z = static_cast<float>(raw.min_z),
               raw_any_xy_z = static_cast<float>(raw.any_xy_above_z);
   const float raw_hx = static_cast<float>(raw.half_xy.x()), raw_hy = static_cast<float>(raw.half_xy.y());
@@ -58,7 +41,7 @@ PreparedCloud Prepare(std::size_t count, ReadPoint point, LengthUnit unit,
   // Reserved, not touched: only the pages actually written are faulted in.
   out.working_Bin.reserve(count);
   out.working_source_index.reserve(count);
-  if (!keep_no_raw) out.raw_Bin.reserve(count);
+  if (!raw.KeepsNone()) out.raw_Bin.reserve(count);
   PlausibilityTally tally(spec.bin, spec.plausibility, count);
   for (std::size_t i = 0; i < count; ++i) {
     if (i % kStopPollInterval == 0) ThrowIfStopped(stop, "prepare");
@@ -86,6 +69,22 @@ PreparedCloud Prepare(std::size_t count, ReadPoint point, LengthUnit unit,
 
 }  // namespace
 
+Eigen::Vector3f PackedXyz::Point(std::size_t i) const {
+  const char* p = bytes.data() + 12 * i;
+  Eigen::Vector3f point;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(point.data(), p, 12);
+  } else {
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t bits = 0;
+      for (int b = 0; b < 4; ++b)
+        bits |= static_cast<std::uint32_t>(static_cast<unsigned char>(p[4 * k + b])) << (8 * b);
+      point[k] = std::bit_cast<float>(bits);
+    }
+  }
+  return point;
+}
+
 PreparedCloud PrepareCloud(const Points& points_Sensor, LengthUnit unit, const Eigen::Isometry3d& X_BinSensor,
                            const PrepareSpec& spec, const StopToken* stop) {
   return Prepare(
@@ -95,10 +94,8 @@ PreparedCloud PrepareCloud(const Points& points_Sensor, LengthUnit unit, const E
 
 PreparedCloud PrepareCloud(PackedXyz xyz_Sensor, LengthUnit unit, const Eigen::Isometry3d& X_BinSensor,
                            const PrepareSpec& spec, const StopToken* stop) {
-  const char* bytes = xyz_Sensor.bytes.data();
   return Prepare(
-      xyz_Sensor.size(), [&](std::size_t i) { return ReadPacked(bytes + 12 * i); }, unit, X_BinSensor, spec,
-      stop);
+      xyz_Sensor.size(), [&](std::size_t i) { return xyz_Sensor.Point(i); }, unit, X_BinSensor, spec, stop);
 }
 
 }  // namespace tubepick

@@ -21,6 +21,8 @@ struct PackedXyz {
   std::string_view bytes;
 
   std::size_t size() const { return bytes.size() / 12; }
+  /// Point i, whatever the host's byte order. @pre i < size()
+  Eigen::Vector3f Point(std::size_t i) const;
 };
 
 /// Which raw points (bin frame, metres) a later collision test needs kept: those with z >= min_z
@@ -39,6 +41,7 @@ struct RawRegion {
     return r;
   }
   bool KeepsAll() const { return *this == All(); }
+  bool KeepsNone() const { return *this == None(); }
   /// True when every point `other` keeps, this keeps too (compared field by field).
   bool Covers(const RawRegion& other) const {
     return other.min_z >= min_z && (other.half_xy.array() <= half_xy.array()).all() &&

@@ -311,7 +311,7 @@ void RunServiceBench(ServiceBenchOptions o) {
       clouds.size(), clouds.front().points_Sensor.size(), server->pid(), server->address(), o.workers,
       o.threads_per_call, cores, o.threads_per_call);
   nlohmann::json report;
-  std::map<std::string, double> local_total, server_total;
+  std::map<std::string, double> local_total, call_total;
   for (const std::string& profile : o.profiles) {
     CommonOptions common;
     common.profile = profile;
@@ -322,7 +322,7 @@ void RunServiceBench(ServiceBenchOptions o) {
       service.emplace_back(c, RunService(channel, clouds, profile, o.calls, c));
     report["profiles"][profile] = PrintProfile(profile, local, service);
     local_total[profile] = Median(local.stages.at("total"));
-    server_total[profile] = Median(service.front().second.call);
+    call_total[profile] = Median(service.front().second.call);
   }
   if (o.profiles.size() > 1) {
     const std::string& ref = o.profiles.front();
@@ -330,7 +330,7 @@ void RunServiceBench(ServiceBenchOptions o) {
       const std::string& p = o.profiles[i];
       fmt::print(
           "\n{} / {}: {:.1f}× in-process, {:.1f}× whole call at c = {} (ratios of medians, same run)\n", p,
-          ref, local_total[p] / local_total[ref], server_total[p] / server_total[ref], o.concurrency.front());
+          ref, local_total[p] / local_total[ref], call_total[p] / call_total[ref], o.concurrency.front());
     }
   }
   const PathFigures peak = RunService(channel, clouds, o.profiles.front(), o.calls, o.peak_concurrency);
