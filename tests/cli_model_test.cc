@@ -15,6 +15,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 using testing::CliRun;
 using testing::ReadJson;
@@ -124,6 +125,16 @@ TEST(CliPlan, PlansTheBuiltInSceneAndWritesPlanPickResponse) {
   EXPECT_TRUE(best.contains("placeTcpPose"));
   EXPECT_EQ(best["grasp"]["approach"]["z"].get<double>(), -1.0);
   fs::remove_all(dir);
+}
+
+TEST(CliBenchService, RejectsAnUnknownProfileOrConcurrencyBeforeStartingAServer) {
+  CliRun run = RunCli("bench service --profiles fast,turbo");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("turbo"));
+  EXPECT_THAT(run.output, Not(HasSubstr("tubepick-server pid")));
+  run = RunCli("bench service --concurrency 1,0");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("--concurrency"));
 }
 
 TEST(CliParams, DumpsBothProfiles) {

@@ -27,6 +27,7 @@
 #include "core/common/thread_budget.h"
 #include "core/modeling/cloud_io.h"
 #include "core/modeling/model_tubes.h"
+#include "core/params.h"
 #include "core/planning/pick_planner.h"
 #include "core/planning/plan_placement.h"
 #include "tubepick/v1/service.grpc.pb.h"
@@ -363,11 +364,17 @@ void AddBenchServiceCommand(CLI::App& bench) {
   cmd->add_option("--calls", o->calls, "Calls per column")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--concurrency", o->concurrency, "Service concurrencies")->capture_default_str();
+  cmd->add_option("--concurrency", o->concurrency, "Service concurrencies (space- or comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   cmd->add_option("--peak-concurrency", o->peak_concurrency, "Concurrency of the last run (peak RSS)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
-  cmd->add_option("--profiles", o->profiles, "Profiles, the first the reference")->capture_default_str();
+  cmd->add_option("--profiles", o->profiles, "Profiles, the first the reference (space- or comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(ProfileNames()))
+      ->capture_default_str();
   cmd->add_option("--workers", o->workers, "Server workers (0 = the cores)")->capture_default_str();
   cmd->add_option("--threads-per-call", o->threads_per_call,
                   "Threads per call, server and in-process (0 = cores / workers)")
