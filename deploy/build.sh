@@ -1,11 +1,28 @@
 #!/usr/bin/env bash
 # Installs the Debian dependencies (if missing), configures and builds tubepick into build/.
-# Used by the README, CI (.ci/run via deploy/test.sh) and the Dockerfile alike.
+# Used by the README and CI (.ci/run via deploy/test.sh); the Dockerfile's build stage runs it with
+# --image.
+#
+#   deploy/build.sh          everything: libraries, binaries, tests, benchmarks
+#   deploy/build.sh --image  only what the image ships (tubepick-server, tubepick): no tests, no
+#                            benchmarks, and only the build dependencies those need
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash deploy/install-deps.sh
+targets=()
+case "${1:-}" in
+  "")
+    bash deploy/install-deps.sh
+    ;;
+  --image)
+    bash deploy/install-deps.sh --image-build
+    # Built once, cold (no ccache in the image): precompiled headers save more than they cost.
+    TUBEPICK_CMAKE_ARGS="-DTUBEPICK_BUILD_TESTS=OFF -DTUBEPICK_BUILD_BENCHMARKS=OFF -DTUBEPICK_PCH=ON ${TUBEPICK_CMAKE_ARGS:-}"
+    targets=(--target tubepick-server tubepick)
+    ;;
+  *) echo "usage: $0 [--image]" >&2; exit 2 ;;
+esac
 BUILD_DIR=${BUILD_DIR:-build}
 BUILD_TYPE=${BUILD_TYPE:-Release}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${TUBEPICK_CMAKE_ARGS:-} > "$BUILD_DIR.configure.log" 2>&1 \
   || { cat "$BUILD_DIR.configure.log"; exit 1; }
-cmake --build "$BUILD_DIR" -j "$(nproc)"
+cmake --build "$BUILD_DIR" -j "$(nproc)" "${targets[@]}"

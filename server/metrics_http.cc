@@ -39,6 +39,8 @@ const char* ReasonPhrase(int status) {
       return "Request Header Fields Too Large";
     case 500:
       return "Internal Server Error";
+    case 503:
+      return "Service Unavailable";
     default:
       return "Error";
   }
@@ -97,7 +99,8 @@ std::pair<std::string, int> SplitHostPort(std::string_view address, const std::s
   return {std::string(host), port};
 }
 
-HttpReply HandleMetricsRequest(std::string_view head, const std::function<std::string()>& render) {
+HttpReply HandleMetricsRequest(std::string_view head, const std::function<std::string()>& render,
+                               const std::function<bool()>& serving) {
   const std::size_t line_end = head.find("\r\n");
   const std::string_view line = head.substr(0, line_end);
   // request-line = method SP request-target SP HTTP-version
@@ -121,6 +124,8 @@ HttpReply HandleMetricsRequest(std::string_view head, const std::function<std::s
     return r;
   }
   target = target.substr(0, target.find('?'));
+  if (target == "/healthz" && serving)
+    return serving() ? Plain(200, "SERVING\n") : Plain(503, "NOT_SERVING\n");
   if (target != "/metrics") return Plain(404, "not found; metrics are at /metrics\n");
   HttpReply r;
   r.content_type = "text/plain; version=0.0.4; charset=utf-8";
@@ -129,8 +134,8 @@ HttpReply HandleMetricsRequest(std::string_view head, const std::function<std::s
 }
 
 MetricsHttpServer::MetricsHttpServer(const std::string& address, std::function<std::string()> render,
-                                     std::chrono::milliseconds io_timeout)
-    : render_(std::move(render)), io_timeout_(io_timeout) {
+                                     std::chrono::milliseconds io_timeout, std::function<bool()> serving)
+    : render_(std::move(render)), serving_(std::move(serving)), io_timeout_(io_timeout) {
   const auto [host, port] = SplitHostPort(address, "metrics_address");
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
@@ -232,7 +237,7 @@ void MetricsHttpServer::HandleConnection(int fd) {
   const bool head_only = head.rfind("HEAD ", 0) == 0;
   HttpReply reply;
   try {
-    reply = HandleMetricsRequest(head, render_);
+    reply = HandleMetricsRequest(head, render_, serving_);
   } catch (const std::exception& e) {
     spdlog::error("metrics: rendering failed: {}", e.what());
     reply = Plain(500, "internal error\n");

@@ -7,6 +7,7 @@
 #include <grpcpp/impl/server_builder_option.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <climits>
 #include <cmath>
 #include <condition_variable>
@@ -110,6 +111,8 @@ struct PlannerServer::Impl {
   std::unique_ptr<grpc::Server> server;
   std::unique_ptr<MetricsHttpServer> http;
   int port = 0;
+  /// What grpc.health.v1 says, for the HTTP probe (/healthz): true from Start until Shutdown begins.
+  std::atomic<bool> serving{false};
 
   std::mutex mu;
   std::condition_variable cv;
@@ -160,12 +163,14 @@ void PlannerServer::Start() {
   grpc::HealthCheckServiceInterface* health = m.server->GetHealthCheckService();
   health->SetServingStatus("", true);
   health->SetServingStatus(kServiceName, true);
+  m.serving = true;
 
   if (!config.metrics_address.empty()) {
     try {
-      m.http = std::make_unique<MetricsHttpServer>(config.metrics_address, [&m] {
-        return m.metrics->RenderPrometheus(m.pool->load(), m.service->uploads_in_progress());
-      });
+      m.http = std::make_unique<MetricsHttpServer>(
+          config.metrics_address,
+          [&m] { return m.metrics->RenderPrometheus(m.pool->load(), m.service->uploads_in_progress()); },
+          std::chrono::milliseconds(2000), [&m] { return m.serving.load(); });
     } catch (...) {
       m.server->Shutdown(std::chrono::system_clock::now());
       m.server.reset();
@@ -192,7 +197,7 @@ void PlannerServer::Start() {
         m.pool->workers(), ThreadsPerCall(config), CoresAvailable());
   }
   if (m.http) {
-    spdlog::info("metrics on http://{}:{}/metrics",
+    spdlog::info("metrics on http://{}:{}/metrics (health probe: /healthz)",
                  HostForLog(SplitHostPort(config.metrics_address, "metrics_address").first), m.http->port());
   }
 }
@@ -221,6 +226,7 @@ void PlannerServer::Shutdown(std::chrono::milliseconds grace) {
   spdlog::info("shutting down: {} calls in flight, grace {} ms", m.service->calls_in_flight(), grace.count());
   // Load balancers and health probes see NOT_SERVING first.
   m.server->GetHealthCheckService()->SetServingStatus(false);
+  m.serving = false;
 
   // gRPC refuses new calls at once and cancels the remaining ones at the deadline (their OnCancel
   // stops the tokens). The watchdog also stops every token then, in case a call is between states.

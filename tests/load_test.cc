@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include "clients/cli/inputs/builtin_scene.h"
@@ -109,6 +110,26 @@ TEST(LoadAgainstServer, CountsOkAndInvalidArgumentRoundRobin) {
   EXPECT_NE(text.find("Server RSS"), std::string::npos) << text;
   const std::string json = FormatLoadReportJson(r);
   EXPECT_NE(json.find("\"INVALID_ARGUMENT\": 3"), std::string::npos) << json;
+
+  // The wall-clock timeline: every measured call once, in start order, inside the run, codes as counted.
+  ASSERT_EQ(r.calls.size(), 6u);
+  const double now =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  std::map<std::string, int> codes;
+  for (std::size_t i = 0; i < r.calls.size(); ++i) {
+    const CallTiming& c = r.calls[i];
+    if (i > 0) {
+      EXPECT_GE(c.start_unix_seconds, r.calls[i - 1].start_unix_seconds);
+    }
+    EXPECT_GT(c.start_unix_seconds, now - 60.0);
+    EXPECT_LE(c.start_unix_seconds + c.seconds, now);
+    EXPECT_GT(c.seconds, 0.0);
+    ++codes[c.code];
+  }
+  EXPECT_EQ(codes["OK"], 3);
+  EXPECT_EQ(codes["INVALID_ARGUMENT"], 3);
+  EXPECT_NE(json.find("\"calls\": ["), std::string::npos) << json;
+  EXPECT_NE(json.find("\"start_unix_seconds\""), std::string::npos) << json;
 }
 
 TEST(LoadAgainstServer, PlanPickStreamInSmallChunks) {

@@ -277,10 +277,18 @@ TEST(ServiceHealth, ServingUntilShutdownThenNotServing) {
   EXPECT_EQ(CheckHealth(server.channel(), "no.such.Service").status.error_code(),
             grpc::StatusCode::NOT_FOUND);
 
+  // The HTTP probe on the metrics port says the same (HAProxy, Docker and Kubernetes checks).
+  EXPECT_EQ(HttpExchange(server.metrics_port(), "GET /healthz HTTP/1.1\r\n\r\n").rfind("HTTP/1.1 200 ", 0),
+            0u);
+
   HealthWatch watch(server.channel(), "tubepick.v1.PickPlannerService");
   ASSERT_TRUE(watch.WaitForStatus(kServing));
   auto shutdown = std::async(std::launch::async, [&] { server.server().Shutdown(std::chrono::seconds(5)); });
   EXPECT_TRUE(watch.WaitForStatus(kNotServing)) << "watchers must see NOT_SERVING when shutdown begins";
+  // Draining (the watch still holds a call open): the probe answers 503 so a proxy stops sending.
+  const std::string draining = HttpExchange(server.metrics_port(), "GET /healthz HTTP/1.1\r\n\r\n");
+  EXPECT_EQ(draining.rfind("HTTP/1.1 503 ", 0), 0u) << draining;
+  EXPECT_NE(draining.find("NOT_SERVING"), std::string::npos) << draining;
   watch.CancelAndWait();  // the last open call; shutdown completes without waiting out the grace
   const auto start = std::chrono::steady_clock::now();
   shutdown.get();

@@ -209,6 +209,23 @@ TEST(MetricsHttp, RoutesAndRejects) {
   EXPECT_EQ(HandleMetricsRequest(std::string("GET /met\0rics HTTP/1.1\r\n", 24), render).status, 400);
 }
 
+TEST(MetricsHttp, HealthProbeFollowsTheServingState) {
+  const auto render = [] { return std::string("up 1\n"); };
+  bool serving = true;
+  const std::function<bool()> state = [&serving] { return serving; };
+  HttpReply r = HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render, state);
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.body, "SERVING\n");
+  EXPECT_EQ(HandleMetricsRequest("HEAD /healthz?probe=1 HTTP/1.0\r\n", render, state).status, 200);
+  serving = false;
+  r = HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render, state);
+  EXPECT_EQ(r.status, 503);
+  EXPECT_EQ(r.body, "NOT_SERVING\n");
+  EXPECT_EQ(HandleMetricsRequest("POST /healthz HTTP/1.1\r\n", render, state).status, 405);
+  // Without a serving state there is no probe to answer.
+  EXPECT_EQ(HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render).status, 404);
+}
+
 TEST(MetricsHttp, SlowAndBrokenClientsDoNotStopTheEndpoint) {
   MetricsHttpServer http(
       "127.0.0.1:0", [] { return std::string("up 1\n"); }, std::chrono::milliseconds(200));

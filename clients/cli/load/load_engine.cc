@@ -98,6 +98,7 @@ PreparedCall Prepare(const LoadOptions& o, LoadRpc rpc, const LoadCloud& cloud) 
 struct CallRecord {
   /// Index into LoadOptions::rpcs.
   std::size_t rpc = 0;
+  std::chrono::system_clock::time_point started;
   double seconds = 0.0;
   grpc::StatusCode code = grpc::StatusCode::OK;
   std::string message;
@@ -118,12 +119,14 @@ class Caller {
       context.set_deadline(std::chrono::system_clock::now() +
                            std::chrono::duration_cast<std::chrono::system_clock::duration>(
                                std::chrono::duration<double>(options_.deadline_seconds)));
+    const auto wall_start = std::chrono::system_clock::now();
     const Clock::time_point t0 = Clock::now();
     const grpc::Status status = options_.rpcs[rpc] == LoadRpc::kPlanPickStream
                                     ? Stream(&context, call)
                                     : Unary(&context, methods_[rpc], call);
     CallRecord record;
     record.rpc = rpc;
+    record.started = wall_start;
     record.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     record.code = status.error_code();
     record.message = status.error_message();
@@ -363,6 +366,8 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   std::vector<std::vector<double>> ok_seconds_by_rpc(o.rpcs.size());
   for (const CallRecord& r : records) {
     const std::string code = StatusCodeName(r.code);
+    report.calls.push_back(
+        {std::chrono::duration<double>(r.started.time_since_epoch()).count(), r.seconds, code});
     ++report.status_counts[code];
     RpcReport& by = report.by_rpc[r.rpc];
     ++by.total;
@@ -384,6 +389,9 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
     report.ok_per_second = static_cast<double>(report.ok) / elapsed;
   }
   report.latency = SummarizeLatency(std::move(ok_seconds));
+  std::sort(report.calls.begin(), report.calls.end(), [](const CallTiming& a, const CallTiming& b) {
+    return a.start_unix_seconds < b.start_unix_seconds;
+  });
   if (phase.sampler)
     report.rss = phase.sampler->Stop(o.rss_window_seconds,
                                      o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt);
@@ -514,6 +522,10 @@ std::string FormatLoadReportJson(const LoadReport& r) {
                        {"failed_scrapes", m.failed_scrapes},
                        {"samples", samples}};
   }
+  nlohmann::json calls = nlohmann::json::array();
+  for (const CallTiming& c : r.calls)
+    calls.push_back({{"start_unix_seconds", c.start_unix_seconds}, {"seconds", c.seconds}, {"code", c.code}});
+  j["calls"] = calls;
   return j.dump(2) + "\n";
 }
 

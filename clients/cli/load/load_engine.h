@@ -102,6 +102,15 @@ struct RpcReport {
   LatencySummary latency;
 };
 
+/// One measured call on the wall clock, for lining a run up with events outside it (a replica
+/// killed behind a proxy, a server restarted).
+struct CallTiming {
+  /// When the call started, seconds since the Unix epoch (system clock).
+  double start_unix_seconds = 0.0;
+  double seconds = 0.0;
+  std::string code;  ///< status code name, "OK" included
+};
+
 /// The outcome of one load run (measured phase only), like ghz's summary.
 struct LoadReport {
   std::string rpc;     ///< "plan", "model", "plan-stream"; several joined by commas
@@ -129,6 +138,8 @@ struct LoadReport {
   std::vector<RpcReport> by_rpc;
   /// Present when metrics_url was given.
   std::optional<RssSummary> rss;
+  /// Every measured call in the order they started (JSON report only).
+  std::vector<CallTiming> calls;
 };
 
 /// Runs the load: connects, optionally warms up, then sends the clouds round-robin from
