@@ -12,6 +12,7 @@
 set -euo pipefail
 
 MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
+SECURITY_MIRROR=${DEBIAN_SECURITY_MIRROR:-http://deb.debian.org/debian-security}
 rebuild=0
 case "${1:-}" in
   "") ;;
@@ -31,6 +32,14 @@ root=$WORK/rootfs
 echo "base-images: debootstrap --variant=minbase bookworm from $MIRROR"
 debootstrap --variant=minbase bookworm "$root" "$MIRROR" >"$WORK/debootstrap.log" 2>&1 \
   || { tail -n 30 "$WORK/debootstrap.log" >&2; exit 1; }
+
+# The suites a maintained bookworm host has: point-release updates and security fixes, so that an
+# image built today carries today's fixes (and the very package versions CI's host compiled with).
+cat >"$root/etc/apt/sources.list" <<EOF
+deb $MIRROR bookworm main
+deb $MIRROR bookworm-updates main
+deb $SECURITY_MIRROR bookworm-security main
+EOF
 
 # What every container image of Debian does: no package caches kept, no lists shipped, and a policy
 # that no service starts while packages are installed in a build.

@@ -15,12 +15,14 @@ case "${1:-}" in
     ;;
   --image)
     bash deploy/install-deps.sh --image-build
-    # Built once, cold (no ccache in the image): precompiled headers save more than they cost.
-    TUBEPICK_CMAKE_ARGS="-DTUBEPICK_BUILD_TESTS=OFF -DTUBEPICK_BUILD_BENCHMARKS=OFF -DTUBEPICK_PCH=ON ${TUBEPICK_CMAKE_ARGS:-}"
+    TUBEPICK_CMAKE_ARGS="-DTUBEPICK_BUILD_TESTS=OFF -DTUBEPICK_BUILD_BENCHMARKS=OFF ${TUBEPICK_CMAKE_ARGS:-}"
     targets=(--target tubepick-server tubepick)
     ;;
   *) echo "usage: $0 [--image]" >&2; exit 2 ;;
 esac
+# ccache keys on paths relative to the checkout, so that a build in another directory (the image's
+# /src, a second clone) hits what this one compiled.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
 BUILD_DIR=${BUILD_DIR:-build}
 BUILD_TYPE=${BUILD_TYPE:-Release}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${TUBEPICK_CMAKE_ARGS:-} > "$BUILD_DIR.configure.log" 2>&1 \

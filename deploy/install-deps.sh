@@ -33,7 +33,7 @@ library_dev_packages=(
 if [ "$mode" = image-tools ]; then
   packages=(podman debootstrap haproxy python3-yaml curl)
 elif [ "$mode" = image-build ]; then
-  packages=(g++ make cmake ninja-build pkg-config ca-certificates "${library_dev_packages[@]}")
+  packages=(g++ make cmake ninja-build ccache pkg-config ca-certificates "${library_dev_packages[@]}")
 elif [ "$mode" = runtime ]; then
   # The packages of the libraries `readelf -d build/bin/tubepick-server build/bin/tubepick` lists as
   # NEEDED on bookworm; what those load in turn (abseil, re2, c-ares, OpenSSL, FLANN, ...) comes in
