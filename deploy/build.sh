@@ -20,9 +20,12 @@ case "${1:-}" in
     ;;
   *) echo "usage: $0 [--image]" >&2; exit 2 ;;
 esac
-# ccache keys on paths relative to the checkout, so that a build in another directory (the image's
-# /src, a second clone) hits what this one compiled.
+# ccache keys on paths relative to the checkout, and on the locale (it changes the compiler's
+# messages): both the same wherever this runs, so that a build in another directory or environment
+# (the image's /src, a second clone) hits what this one compiled.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+export LANG=C.UTF-8
+unset LC_ALL LC_CTYPE LC_MESSAGES
 BUILD_DIR=${BUILD_DIR:-build}
 BUILD_TYPE=${BUILD_TYPE:-Release}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${TUBEPICK_CMAKE_ARGS:-} > "$BUILD_DIR.configure.log" 2>&1 \

@@ -98,6 +98,12 @@ wait_for() {
 image_field() { podman image inspect --format "{{json .Config.$2}}" "$1"; }
 json_words() { "$PY" -c 'import json,sys; sys.stdout.write("".join(w + "\n" for w in json.loads(sys.stdin.read()) or []))'; }
 
+# container_user ROOT USER FIELDS: USER (a name or a uid; empty = root) as the container's own
+# /etc/passwd knows it, printed as awk prints FIELDS ($3 ":" $4 for chroot's --userspec, $6 home).
+container_user() {
+  awk -F: -v u="${2:-root}" "\$1 == u || \$3 == u { print $3; exit }" "$1/etc/passwd"
+}
+
 # --- runner --------------------------------------------------------------------------------------
 RUNNER=${TUBEPICK_IMAGE_RUNNER:-}
 probe_runner() {
@@ -144,10 +150,9 @@ start_container() {
   [ ${#args[@]} -gt 0 ] && command=("${args[@]}")
   user=$(podman image inspect --format '{{.Config.User}}' "$image")
   workdir=$(podman image inspect --format '{{.Config.WorkingDir}}' "$image")
-  # The user as the container knows it (its /etc/passwd), numerically, for chroot.
   local ids home
-  ids=$(awk -F: -v u="${user:-root}" '$1 == u || $3 == u { print $3 ":" $4; exit }' "$root/etc/passwd")
-  home=$(awk -F: -v u="${user:-root}" '$1 == u || $3 == u { print $6; exit }' "$root/etc/passwd")
+  ids=$(container_user "$root" "$user" '$3 ":" $4')
+  home=$(container_user "$root" "$user" '$6')
   [ -n "$ids" ] || fail "$image: user '$user' is not in its /etc/passwd"
   env -i "${image_env[@]}" HOME="$home" "${envs[@]}" \
     chroot --userspec="$ids" "$root" /bin/sh -c 'cd "$0" && exec "$@"' "${workdir:-/}" \
@@ -167,7 +172,7 @@ exec_in() {
   local root user ids
   root=$(podman mount "$name")
   user=$(podman inspect --format '{{.Config.User}}' "$name")
-  ids=$(awk -F: -v u="${user:-root}" '$1 == u || $3 == u { print $3 ":" $4; exit }' "$root/etc/passwd")
+  ids=$(container_user "$root" "$user" '$3 ":" $4')
   env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin chroot --userspec="$ids" "$root" "$@"
 }
 
