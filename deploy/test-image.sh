@@ -227,7 +227,7 @@ build_images() {
   podman build --isolation chroot --network host --format docker "${cache_flags[@]}" -f deploy/Dockerfile \
     -t "$IMAGE" . >"$WORK/build-image.log" 2>&1 || fail "podman build deploy/Dockerfile"
   say "tubepick image built in $((SECONDS - start)) s${cache_dir:+ (compiler cache $cache_dir lent to the build stage)}"
-  grep -a -o 'ccache-stats: .*' "$WORK/build-image.log" | sed 's/^/test-image: /' || true
+  grep -a -o 'ccache-stats: Cacheable.*' "$WORK/build-image.log" | sed 's/^/test-image: /' || true
 }
 
 # --- 3. layer cache -------------------------------------------------------------------------------
