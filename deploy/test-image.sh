@@ -195,7 +195,8 @@ stop_container() {
   fail "stop_container: no container $name"
 }
 
-serving() { "$CLI" health --target "$1" --timeout 2 | grep -q SERVING; }
+# `tubepick health` exits 0 only for SERVING (a grep for "SERVING" would take NOT_SERVING too).
+serving() { "$CLI" health --target "$1" --timeout 2 >/dev/null; }
 
 # --- 1. base images, tools ------------------------------------------------------------------------
 base() {
@@ -350,6 +351,19 @@ EOF
 # --- 7. replicas behind the proxy -----------------------------------------------------------------
 # metric PORT SERIES: the value of SERIES on a replica's /metrics (awk reads to the end: no SIGPIPE).
 metric() { curl -fsS "http://127.0.0.1:$1/metrics" | awk -v s="$2" '$1 == s { v = $2 } END { print v }'; }
+# planpicks_served: each replica's successful PlanPicks, "-" for the one named in $1 (dead).
+planpicks_served() {
+  local n
+  for n in 1 2 3; do
+    if [ "$n" = "${1:-}" ]; then echo -n "- "; else echo -n "$(metric "947$n" 'tubepick_rpc_requests_total{method="PlanPick",code="OK"}') "; fi
+  done
+}
+# proxy_has SERVER STATE: HAProxy's Prometheus page says SERVER (planner-N) is in STATE (UP, DOWN).
+proxy_has() {
+  curl -fsS http://127.0.0.1:8404/metrics \
+    | grep -q "^haproxy_server_status{proxy=\"planners\",server=\"$1\",state=\"$2\"} 1"
+}
+proxy_all_up() { proxy_has planner-1 UP && proxy_has planner-2 UP && proxy_has planner-3 UP; }
 proxy_failover() {
   [ "$PLANNERS" = 3 ] || fail "the compose file has $PLANNERS planners; this test expects 3"
   local n grpc_port health_port proxy_env=()
@@ -370,8 +384,7 @@ proxy_failover() {
   done
   for n in 1 2 3; do wait_for "replica $n SERVING" 60 serving "127.0.0.1:5016$n"; done
   start_container proxy "$PROXY_IMAGE" "${proxy_env[@]}" --
-  wait_for "HAProxy sees 3 replicas UP" 30 sh -c \
-    "[ \"\$(curl -fsS http://127.0.0.1:8404/metrics | grep -c '^haproxy_server_status{proxy=\"planners\",server=\"planner-[123]\",state=\"UP\"} 1')\" = 3 ]"
+  wait_for "HAProxy sees 3 replicas UP" 30 proxy_all_up
   wait_for "health SERVING through the proxy" 30 serving 127.0.0.1:50160
   say "3 replicas UP behind HAProxy"
 
@@ -389,18 +402,17 @@ proxy_failover() {
   [ -n "$victim" ] || fail "no replica was busy 6 s into the load run"
   local victim_pid_var=REPLICA_PID_$victim
   local served_before
-  served_before=$(for n in 1 2 3; do metric "947$n" 'tubepick_rpc_requests_total{method="PlanPick",code="OK"}'; done | tr '\n' ' ')
+  served_before=$(planpicks_served)
   t_kill=$(date +%s.%N)
   kill -KILL "${!victim_pid_var}"
   wait "${!victim_pid_var}" 2>/dev/null || true # reaped: its sockets are closed
   t_dead=$(date +%s.%N)
   say "killed replica $victim (busy) at $(date -u +%T.%3N); PlanPicks served so far per replica: $served_before"
-  wait_for "HAProxy marks replica $victim DOWN" 10 sh -c \
-    "curl -fsS http://127.0.0.1:8404/metrics | grep -q '^haproxy_server_status{proxy=\"planners\",server=\"planner-$victim\",state=\"DOWN\"} 1'"
+  wait_for "HAProxy marks replica $victim DOWN" 10 proxy_has "planner-$victim" DOWN
   say "HAProxy marked planner-$victim DOWN after $("$PY" -c "import time,sys; print(f'{time.time()-float(sys.argv[1]):.1f}')" "$t_kill") s"
   wait "$load_pid" || true
   local after
-  after=$(for n in 1 2 3; do [ "$n" = "$victim" ] && { echo -n "- "; continue; }; metric "947$n" 'tubepick_rpc_requests_total{method="PlanPick",code="OK"}'; done | tr '\n' ' ')
+  after=$(planpicks_served "$victim")
   say "PlanPicks served per replica at the end: $after"
   "$PY" - "$WORK/proxy-load.json" "$t_kill" "$t_dead" "$served_before" <<'EOF' || fail "failover"
 import json, sys
