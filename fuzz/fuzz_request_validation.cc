@@ -79,7 +79,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else {
       v1::AnalyzeWrenchRequest request;
       if (!Parse(data, size, &request)) return 0;
-      const server::WrenchJob job = server::ValidateAnalyzeWrench(request, Defaults());
+      const WrenchJob job = server::ValidateAnalyzeWrench(request, Defaults());
       Check(std::isfinite(job.tube_mass) && job.tube_mass > 0.0);
       Check(job.reference.force.allFinite() && job.current.torque.allFinite());
       Check(job.X_BinTcp.matrix().allFinite());

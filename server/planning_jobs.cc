@@ -65,15 +65,4 @@ v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults&
   return response;
 }
 
-v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job) {
-  const HeldCount count = CountHeldTubes(job.reference, job.current, job.tube_mass, job.params);
-  std::optional<ResolutionPlan> resolution;
-  Eigen::Vector3d delta_torque_Tcp = Eigen::Vector3d::Zero();
-  if (count.outcome == HeldOutcome::kMultiple) {
-    delta_torque_Tcp = HorizontalTorqueChange(job.reference, job.current, job.params.up_Tcp);
-    resolution = PlanResolutionRotation(job.reference, job.current, job.X_BinTcp, job.params);
-  }
-  return ToAnalyzeWrenchResponse(count, resolution, delta_torque_Tcp);
-}
-
 }  // namespace tubepick::server

@@ -25,9 +25,4 @@ v1::ModelTubesResponse RunModelTubes(const PlanningJob& job, std::uint32_t threa
 v1::PlanPickResponse RunPlanPick(const PlanningJob& job, const PlanningDefaults& defaults,
                                  std::uint32_t threads, const StopToken* stop);
 
-/// Algorithm 3 (CountHeldTubes with job.params.up_Tcp) and, when several tubes are held, the
-/// horizontal torque change and PlanResolutionRotation's motions (none when |ΔM| < min_torque).
-/// Fast and bounded: runs without a stop token.
-v1::AnalyzeWrenchResponse RunAnalyzeWrench(const WrenchJob& job);
-
 }  // namespace tubepick::server

@@ -23,12 +23,6 @@ constexpr double kMaxTubeLength = 10.0;  // m
 constexpr double kMinTubeMass = 0.001;   // kg
 constexpr double kMaxTubeMass = 50.0;
 
-std::string Degrees(double radians) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.1f deg", radians * 180.0 / M_PI);
-  return buffer;
-}
-
 // lo < value ≤ hi (lo_open) or lo ≤ value ≤ hi.
 void RequireRange(double value, double lo, double hi, bool lo_open, const std::string& field,
                   const std::string& unit) {
@@ -223,31 +217,8 @@ WrenchJob ValidateAnalyzeWrench(const v1::AnalyzeWrenchRequest& request, const P
     job.params.variant = *variant;
   }
 
-  // The vertical comes from the request's pose, not from the configured wrench.up_Tcp: the sensor
-  // axes are the TCP's (wrench.h), so the upward direction in the sensor frame is
-  // up_Tcp = R_BinTcpᵀ · z_Bin. Our grasp TCPs point z down (approach), which gives (0, 0, −1);
-  // a thesis-style sensor with z up gives (0, 0, 1). F_z of Algorithm 3 is then force · up_Tcp.
-  const Eigen::Matrix3d R_BinTcp = job.X_BinTcp.linear();
-  job.params.up_Tcp = R_BinTcp.transpose() * Eigen::Vector3d::UnitZ();
-  // With up_Tcp taken from the pose, the resolution planner's tilt guard always passes; keep its
-  // intent here: the tool axis (TCP z, up or down) must be within wrench.max_tilt of the vertical.
-  const double tilt = std::acos(std::clamp(std::abs(R_BinTcp(2, 2)), 0.0, 1.0));
-  if (tilt > job.params.max_tilt) {
-    throw InvalidArgument("tcp_pose.orientation: the TCP z axis is " + Degrees(tilt) +
-                          " from the vertical (wrench.max_tilt " + Degrees(job.params.max_tilt) +
-                          "); the gripper must be vertical at lift");
-  }
-  // A joint-safe axis fixed in the TCP frame is horizontal for the configured up_Tcp; re-project it
-  // onto the horizontal plane of this pose (it differs by at most max_tilt).
-  if (job.params.joint_safe_frame == JointSafeFrame::kTcp) {
-    const Eigen::Vector3d up = job.params.up_Tcp;
-    Eigen::Vector3d axis = job.params.joint_safe_axis.normalized();
-    axis -= axis.dot(up) * up;
-    if (axis.norm() < 1e-6) {
-      throw InvalidArgument("tcp_pose.orientation: the vertical is parallel to wrench.joint_safe_axis");
-    }
-    job.params.joint_safe_axis = axis.normalized();
-  }
+  // The vertical comes from the request's pose, not from the configured wrench.up_Tcp.
+  job.params = WrenchParamsAtPose(job.params, job.X_BinTcp);
 
   const double weight = job.tube_mass * job.params.gravity;
   if (!(job.params.force_tolerance < weight)) {

@@ -11,6 +11,7 @@
 #include "server/server_config.h"
 #include "tubepick/v1/requests.pb.h"
 #include "tubepick/v1/wrench.pb.h"
+#include "wire/wrench_analysis.h"
 
 namespace tubepick::server {
 
@@ -60,13 +61,6 @@ PlanningJob ValidatePlanPick(const v1::PlanPickRequest& request, std::string_vie
                              const PlanningDefaults& defaults);
 
 /// A validated AnalyzeWrench request.
-struct WrenchJob {
-  Wrench reference;
-  Wrench current;
-  double tube_mass = 0.0;
-  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
-  WrenchParams params;
-};
 /// reference, current and tcp_pose are required; tube_mass absent ⇒ defaults.cell's, in
 /// [0.001, 50] kg and heavier than wrench.force_tolerance; variant UNSPECIFIED ⇒ the profile's. The
 /// params are defaults.profiles[defaults.profile].wrench with up_Tcp = R_BinTcpᵀ · z_Bin: the pose

@@ -52,6 +52,43 @@ TEST(CellCliTest, UnreachableServerEndsInASafeStopAndExitStatus3) {
   EXPECT_NE(run.output.find("the remaining rounds are skipped"), std::string::npos) << run.output;
 }
 
+// A small fault campaign: faults at random moments of the state machine, place included; what
+// must never happen is a tube at rest outside the bin and the place zone.
+TEST(CellCliTest, FaultCampaignNeverReleasesATubeOutsideTheBinOrThePlaceZone) {
+  const auto dir = testing::TempDir("cell-faults");
+  const auto json_path = dir / "campaign.json";
+  const testing::CliRun run = RunCli(
+      "cell --sim --rounds 4 --tubes 7 --inject-faults 0.1 --fault-seed 3 --json " + json_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::smatch m;
+  const std::string output = run.output;
+  ASSERT_TRUE(
+      std::regex_search(output, m,
+                        std::regex("faults: injected=(\\d+) safe_stops=(\\d+) released_outside=(\\d+) "
+                                   "lost_in_transit=(\\d+) bins_emptied=(\\d+)/4\n")))
+      << run.output;
+  EXPECT_GT(std::stoi(m[1]), 0);
+  EXPECT_EQ(m[3], "0");
+  const nlohmann::json j = testing::ReadJson(json_path);
+  const nlohmann::json& faults = j["faults"];
+  EXPECT_EQ(faults["rounds"], 4);
+  EXPECT_EQ(faults["released_outside"], 0);
+  EXPECT_EQ(faults["injected"], std::stoi(m[1]));
+  int by_kind = 0;
+  for (const auto& [kind, count] : faults["by_kind"].items()) by_kind += count.get<int>();
+  EXPECT_EQ(by_kind, faults["injected"].get<int>());
+  int elsewhere = 0;
+  for (const nlohmann::json& round : j["rounds"]) elsewhere += round["released_outside"].get<int>();
+  EXPECT_EQ(elsewhere, 0);
+}
+
+TEST(CellCliTest, InjectedFaultRateOutsideZeroToOneIsRefused) {
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --inject-faults 5");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--inject-faults: a probability per state in [0, 1], got 5"), std::string::npos)
+      << run.output;
+}
+
 TEST(CellCliTest, WithoutSimItSaysWhy) {
   const testing::CliRun run = RunCli("cell --rounds 1");
   EXPECT_EQ(run.exit_code, 2) << run.output;

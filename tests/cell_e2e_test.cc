@@ -134,24 +134,73 @@ TEST_F(CellEndToEndTest, TubeAlongALongWallIsNudgedOffItAndPicked) {
   EXPECT_EQ(stats.attempts, 1u);  // nudges are not picking attempts
 }
 
-TEST_F(CellEndToEndTest, ServerGoneMidRoundEndsInSafeStopWithTheGripperOpen) {
+TEST_F(CellEndToEndTest, ServerGoneWhileATubeIsHeldIsAnalysedLocallyThenTheRoundSafeStops) {
   cell::GrpcPlannerClientOptions options;
   options.max_retries = 1;
   options.initial_backoff = std::chrono::milliseconds(10);
   cell::GrpcPlannerClient planner(address(), options);
-  server_->Shutdown(std::chrono::milliseconds(0));
   cell::MemoryRecordSink sink;
-  const cli::SimRoundResult r = cli::RunSimRound(
-      planner, devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3), {}, 0, &sink);
+  devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
+  // The server goes away the first time a lifted tube is about to be analysed: mid-round, with
+  // a tube in the gripper.
+  bool stopped = false;
+  const auto stop_server_at_analyze = [&](cell::CellState state) {
+    if (state != cell::CellState::kAnalyze || stopped) return;
+    ASSERT_FALSE(sim.HeldTubes().empty());
+    server_->Shutdown(std::chrono::milliseconds(0));
+    stopped = true;
+  };
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, stop_server_at_analyze);
+
+  ASSERT_TRUE(stopped);
+  // The held tube was analysed here and placed; the next PlanPick found no planner: a safe stop
+  // with nothing held, where the arm was.
+  EXPECT_EQ(r.run.picks, 1u) << r.run.message;
+  EXPECT_EQ(r.run.local_analyses, 1u);
   EXPECT_EQ(r.run.reason, cell::CellStopReason::kFault);
   ASSERT_TRUE(r.run.fault);
   EXPECT_EQ(r.run.fault->device(), "planner");
   EXPECT_EQ(r.run.fault->kind(), cell::FaultKind::kServerUnavailable);
-  EXPECT_TRUE(r.run.gripper_opened);
-  EXPECT_TRUE(r.run.moved_up);
-  EXPECT_EQ(r.tubes_in_bin, 2u);
+  EXPECT_EQ(r.run.fault->state(), "plan");
+  ASSERT_TRUE(r.run.safe_stop);
+  EXPECT_EQ(r.run.safe_stop->action, "stopped");
+  EXPECT_EQ(r.tubes_in_bin, 1u);
+  EXPECT_EQ(r.tubes_in_place_zone, 1u);
+  EXPECT_EQ(r.tubes_elsewhere, 0u);
+  const json picked = sink.records().at(0);
+  EXPECT_EQ(picked["result"], "picked");
+  EXPECT_EQ(picked["analysis"]["outcome"], "single");
+  EXPECT_EQ(picked["analysis_fallback"]["local_analyses"], 1);
   EXPECT_NE(r.run.message.find("SAFE STOP: planner server_unavailable during plan"), std::string::npos)
       << r.run.message;
+}
+
+TEST_F(CellEndToEndTest, TubeThatSlipsInTransitFallsIntoTheBinOrThePlaceZoneAndIsRecordedAsLost) {
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+  devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
+  // The first transit to the place: the tube slips out 1.2 s in (moving across at transit height).
+  bool armed = false;
+  const auto slip_in_transit = [&](cell::CellState state) {
+    if (state != cell::CellState::kPlace || armed) return;
+    sim.ArmSlip(1.2);
+    armed = true;
+  };
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, slip_in_transit);
+
+  ASSERT_TRUE(armed);
+  EXPECT_EQ(sim.fault_events().slips, 1u);
+  EXPECT_EQ(r.run.lost, 1u) << r.run.message;
+  EXPECT_EQ(r.tubes_elsewhere, 0u);  // it fell back into the bin or onto the place zone
+  EXPECT_EQ(r.tubes_held, 0u);
+  const json& lost = sink.records().at(0);
+  EXPECT_EQ(lost["result"], "lost");
+  EXPECT_EQ(lost["lost"]["state"], "place_transit");
+  EXPECT_EQ(lost["lost"]["detected_by"], "gripper_status");
+  // The round went on: rescanned and picked what was left in the bin.
+  EXPECT_EQ(r.run.reason, cell::CellStopReason::kBinEmpty) << r.run.message;
+  EXPECT_EQ(r.tubes_in_bin, 0u);
+  EXPECT_EQ(r.tubes_in_place_zone, 2u);
 }
 
 }  // namespace

@@ -85,14 +85,20 @@ nlohmann::json FaultJson(const CellFault& fault) {
 }
 
 nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result) {
+  nlohmann::json p_Bin_tcp = nullptr;
+  if (result.safe_stop && result.safe_stop->p_Bin_tcp) {
+    const Eigen::Vector3d& p = *result.safe_stop->p_Bin_tcp;
+    p_Bin_tcp = {p.x(), p.y(), p.z()};
+  }
   return {{"type", "safe_stop"},
           {"round", round},
           {"device", fault.device()},
           {"kind", ToString(fault.kind())},
           {"state", fault.state()},
           {"error", fault.error()},
-          {"gripper_opened", result.gripper_opened},
-          {"moved_up", result.moved_up},
+          {"held", ToString(result.safe_stop ? result.safe_stop->held : Held::kNothing)},
+          {"action", result.safe_stop ? result.safe_stop->action : "stopped"},
+          {"p_Bin_tcp", p_Bin_tcp},
           {"message", result.message}};
 }
 
@@ -106,6 +112,7 @@ nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const
           {"attempts", result.attempts},
           {"scans", result.scans},
           {"nudges", result.nudges},
+          {"lost", result.lost},
           {"truth_start", truth_start},
           {"truth", truth}};
 }

@@ -62,10 +62,12 @@ nlohmann::json NudgeJson(const NudgePlan& nudge);
 /// {"device", "kind", "state", "error"}.
 nlohmann::json FaultJson(const CellFault& fault);
 
-/// {"type": "safe_stop", round, device, kind, state, error, gripper_opened, moved_up, message}.
+/// {"type": "safe_stop", round, device, kind, state, error, held ("nothing", "tube", "unknown"),
+/// action ("stopped", "released_in_bin", "kept_closed"), p_Bin_tcp (where the TCP ended, or null),
+/// message}.
 nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result);
 
-/// {"type": "end", round, reason, message, picks, attempts, scans, nudges, truth_start, truth}.
+/// {"type": "end", round, reason, message, picks, attempts, scans, nudges, lost, truth_start, truth}.
 nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const nlohmann::json& truth_start,
                          const nlohmann::json& truth);
 

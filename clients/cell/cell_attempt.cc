@@ -3,10 +3,12 @@
 // Poses are X_BinTcp…: the TCP in the bin frame.
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
 #include "wire/proto_convert.h"
 
@@ -98,10 +100,16 @@ void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& at
     attempt.result = AttemptResult::kGraspFailed;
     return;
   }
-  const Eigen::Isometry3d X_BinTcpLift = Lift(poses.waypoints_Bin, attempt);
-  const v1::AnalyzeWrenchResponse analysis = AnalyzeLift(reference, X_BinTcpLift, attempt);
-  attempt.result = Conclude(analysis.outcome(), poses.X_BinTcpPlace, attempt);
-  if (!attempt.result) attempt.result = Resolve(analysis, reference, poses, X_BinTcpLift, attempt);
+  try {
+    const Eigen::Isometry3d X_BinTcpLift = Lift(poses.waypoints_Bin, attempt);
+    CheckStillHolding("lift", attempt);
+    const v1::AnalyzeWrenchResponse analysis = AnalyzeLift(reference, X_BinTcpLift, attempt);
+    attempt.result = Conclude(analysis.outcome(), poses.X_BinTcpPlace, reference, attempt);
+    if (!attempt.result) attempt.result = Resolve(analysis, reference, poses, X_BinTcpLift, attempt);
+  } catch (const TubeLost& lost) {
+    RecordLost(lost, attempt);
+    attempt.result = AttemptResult::kLost;
+  }
 }
 
 /// Transit to the pre-grasp pose, open to the grasp width.
@@ -128,9 +136,12 @@ devices::WrenchReading CellController::TakeReference(Attempt& attempt) {
 bool CellController::Grasp(const Eigen::Isometry3d& X_BinTcpGrasp, Attempt& attempt) {
   Enter(CellState::kGrasp);
   MoveTo(X_BinTcpGrasp, params_.approach_speed, &attempt);
+  held_ = Held::kUnknown;  // closing: until the gripper reports
   const devices::GripperStatus closed = CloseGripper();
   attempt.record["gripper"] = GripperJson(closed);
-  return closed.object == devices::GripperObject::kStoppedClosing;
+  const bool object = closed.object == devices::GripperObject::kStoppedClosing;
+  held_ = object ? Held::kTube : Held::kNothing;
+  return object;
 }
 
 /// Nothing grasped: open, back up to the pre-grasp pose, home.
@@ -164,10 +175,11 @@ v1::AnalyzeWrenchResponse CellController::AnalyzeLift(const devices::WrenchReadi
 
 std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOutcome outcome,
                                                                       const Eigen::Isometry3d& X_BinTcpPlace,
+                                                                      const devices::WrenchReading& reference,
                                                                       Attempt& attempt) {
   switch (outcome) {
     case v1::HELD_OUTCOME_SINGLE:
-      Place(X_BinTcpPlace, attempt);
+      Place(X_BinTcpPlace, reference, attempt);
       return AttemptResult::kPicked;
     case v1::HELD_OUTCOME_NONE:
       ReleaseEmpty(attempt);
@@ -190,7 +202,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
     const v1::AnalyzeWrenchResponse again =
         ResolutionMotion(analysis.resolution_motions(m), m, reference, X_BinTcpLift, attempt);
     if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
-    if (const std::optional<AttemptResult> result = Conclude(again.outcome(), poses.X_BinTcpPlace, attempt))
+    if (const std::optional<AttemptResult> result =
+            Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))
       return *result;
   }
   PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, attempt);
@@ -208,6 +221,7 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
     MoveTo(X_BinTcpWaypoint, params_.resolution_speed, &attempt);
   }
   MoveTo(X_BinTcpLift, params_.resolution_speed, &attempt);
+  CheckStillHolding("resolve", attempt);
   const devices::WrenchReading after = ReadWrench();
   const v1::AnalyzeWrenchResponse again = Analyze(reference, after, X_BinTcpLift, attempt);
   attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, after, again));
@@ -216,15 +230,67 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
 
 // ---------------------------------------------------------------- endings
 
-/// One tube held: transit above the place pose, down, open, up, home.
-void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, Attempt& attempt) {
+/// One tube held: transit above the place pose (the gripper's object status checked after every
+/// segment), a reading there that must still weigh a tube, down, the status once more, open, up,
+/// home.
+void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
+                           Attempt& attempt) {
   Enter(CellState::kPlace);
   Eigen::Isometry3d X_BinTcpAbovePlace = X_BinTcpPlace;
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
-  TransitTo(X_BinTcpAbovePlace, &attempt);
+  TransitTo(X_BinTcpAbovePlace, &attempt, [&] { CheckStillHolding("place_transit", attempt); });
+  CheckLoadBeforePlace(reference, attempt);
   MoveTo(X_BinTcpPlace, params_.approach_speed, &attempt);
+  CheckStillHolding("place_descent", attempt);
   OpenGripper();
+  attempt.record["placed"] = true;  // a fault on the way home does not undo the pick
   MoveTo(X_BinTcpAbovePlace, params_.approach_speed, &attempt);
+  GoHome(&attempt);
+}
+
+void CellController::CheckStillHolding(const char* where, Attempt& attempt) {
+  const devices::GripperStatus status = CheckGripper(
+      CallDevice("gripper", state_, [&] { return devices_.gripper->Status(params_.gripper_timeout); }));
+  if (status.object == devices::GripperObject::kStoppedClosing) return;
+  held_ = Held::kNothing;
+  attempt.record["gripper_lost"] = GripperJson(status);
+  throw TubeLost(
+      where, "gripper_status",
+      fmt::format("the gripper no longer reports an object (fingers at {:.1f} mm)", status.opening * 1e3));
+}
+
+void CellController::CheckLoadBeforePlace(const devices::WrenchReading& reference, Attempt& attempt) {
+  const devices::WrenchReading above = ReadWrench();
+  v1::AnalyzeWrenchRequest request;
+  *request.mutable_reference() = ToProto(Wrench{reference.force, reference.torque});
+  *request.mutable_current() = ToProto(Wrench{above.force, above.torque});
+  request.set_tube_mass(cell_.tube.mass);
+  *request.mutable_tcp_pose() = ToProto(CurrentPose());
+  const v1::AnalyzeWrenchResponse check = LocalAnalyzeWrench(request, params_.profile);
+  attempt.record["wrench"]["before_place"] = WrenchJson(above);
+  if (check.outcome() != v1::HELD_OUTCOME_NONE) return;
+  throw TubeLost("place_transit", "wrench",
+                 fmt::format("the load above the place pose weighs {:.2f} N more than the empty gripper "
+                             "(one tube: {:.2f} N)",
+                             check.held_weight(), check.tube_weight()));
+}
+
+void CellController::RecordLost(const TubeLost& lost, Attempt& attempt) {
+  nlohmann::json where = {{"state", lost.state},
+                          {"detected_by", lost.detected_by},
+                          {"detail", lost.what()},
+                          {"device_time_s", DeviceNow()}};
+  try {
+    const Eigen::Vector3d p_Bin_tcp = CurrentPose().translation();
+    where["p_Bin_tcp"] = {p_Bin_tcp.x(), p_Bin_tcp.y(), p_Bin_tcp.z()};
+  } catch (const CellFault&) {
+    where["p_Bin_tcp"] = nullptr;
+  }
+  attempt.record["lost"] = where;
+  spdlog::warn("cell: round {}: tube lost during {} ({}: {})", round_, lost.state, lost.detected_by,
+               lost.what());
+  Enter(CellState::kRelease);
+  OpenGripper();  // the fingers closed on nothing
   GoHome(&attempt);
 }
 

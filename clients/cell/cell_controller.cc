@@ -18,7 +18,7 @@ namespace tubepick::cell {
 namespace {
 
 const char* ResultName(int result) {
-  static const char* const kNames[] = {"picked", "multiple_returned", "none", "grasp_failed"};
+  static const char* const kNames[] = {"picked", "multiple_returned", "none", "grasp_failed", "lost"};
   return kNames[result];
 }
 
@@ -27,9 +27,7 @@ const char* ResultName(int result) {
 using detail::CallDevice;
 using detail::CallPlanner;
 using detail::Clock;
-using detail::kSameHeight;
 using detail::SecondsSince;
-using detail::WithHeight;
 
 std::string ToString(CellState state) {
   switch (state) {
@@ -69,6 +67,18 @@ std::string ToString(CellState state) {
   return "unknown";
 }
 
+std::string ToString(Held held) {
+  switch (held) {
+    case Held::kNothing:
+      return "nothing";
+    case Held::kTube:
+      return "tube";
+    case Held::kUnknown:
+      return "unknown";
+  }
+  return "unknown";
+}
+
 std::string ToString(CellStopReason reason) {
   switch (reason) {
     case CellStopReason::kBinEmpty:
@@ -93,6 +103,7 @@ CellController::CellController(CellDevices devices, PlannerClient& planner, Cell
 void CellController::Enter(CellState state) {
   state_ = state;
   spdlog::debug("cell: {}", ToString(state));
+  if (observer_) observer_(state);
 }
 
 double CellController::DeviceNow() const { return device_clock_ ? device_clock_() : 0.0; }
@@ -256,6 +267,7 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   d["attempt_wall_s"] = SecondsSince(attempt.started);
   d["attempt_device_s"] = DeviceNow() - attempt.device_started;
   record["truth_after"] = Truth();
+  run.result.local_analyses += attempt.local_analyses;
   if (sink_) sink_->Write(record);
   spdlog::info("cell: round {} attempt {}: tube {} {} -> {}", round_, run.result.attempts,
                record.value("tube", 0u), record.value("trajectory_kind", ""),
@@ -265,6 +277,7 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
 }
 
 bool CellController::CountAttempt(AttemptResult outcome, RunState& run) {
+  if (outcome == AttemptResult::kLost) ++run.result.lost;
   if (outcome == AttemptResult::kPicked) {
     ++run.result.picks;
     run.attempts_since_pick = 0;
@@ -342,62 +355,21 @@ nlohmann::json CellController::Nudge(const NudgePlan& nudge, nlohmann::json reco
   return record;
 }
 
-// ---------------------------------------------------------------- fault, safe stop
+// ---------------------------------------------------------------- fault (the safe stop: cell_safe_stop.cc)
 
 void CellController::RecordFaultedAttempt(RunState& run, const CellFault& fault) {
   if (!run.active) return;
+  run.result.local_analyses += run.active->local_analyses;
   nlohmann::json& record = run.active->record;
-  record["result"] = "fault";
+  // A tube already placed when the fault came (on the way home) is a pick, with the fault beside it.
+  const bool placed = record.value("placed", false);
+  if (placed) ++run.result.picks;
+  record["result"] = placed ? "picked" : "fault";
   record["fault"] = FaultJson(fault);
   record["durations"]["robot_wall_s"] = run.active->robot_wall_s;
   record["durations"]["robot_device_s"] = run.active->robot_device_s;
   record["truth_after"] = Truth();
   if (sink_) sink_->Write(record);
-}
-
-/// Open the gripper and move up, as far as the devices still allow; never throws.
-void CellController::SafeStop(const CellFault& fault, CellRunResult& result) {
-  Enter(CellState::kSafeStop);
-  spdlog::error("cell: {}", fault.what());
-  const std::string gripper_note = SafeStopOpenGripper(result);
-  const std::string robot_note = SafeStopMoveUp(result);
-  result.reason = CellStopReason::kFault;
-  result.fault = fault;
-  result.message =
-      fmt::format("SAFE STOP: {} {} during {}: {}; {}; {}", fault.device(), ToString(fault.kind()),
-                  fault.state(), fault.error(), gripper_note, robot_note);
-  spdlog::error("cell: {}", result.message);
-  if (sink_) sink_->Write(SafeStopRecord(round_, fault, result));
-}
-
-std::string CellController::SafeStopOpenGripper(CellRunResult& result) {
-  try {
-    const devices::GripperStatus status = devices_.gripper->Open(params_.gripper_timeout);
-    result.gripper_opened = status.fault == 0;
-    return result.gripper_opened ? "gripper opened"
-                                 : fmt::format("gripper could not be opened (fault 0x{:02X}: {})",
-                                               status.fault, status.fault_text);
-  } catch (const std::exception& e) {
-    return fmt::format("gripper could not be opened ({})", e.what());
-  }
-}
-
-std::string CellController::SafeStopMoveUp(CellRunResult& result) {
-  try {
-    const Eigen::Isometry3d X_BinTcpNow = devices_.robot->CurrentPose(params_.robot_timeout);
-    const double z_safe = TransitHeight(params_, cell_);
-    std::string note;
-    if (X_BinTcpNow.translation().z() < z_safe - kSameHeight) {
-      devices_.robot->MoveTo(WithHeight(X_BinTcpNow, z_safe), params_.transit_speed, params_.robot_timeout);
-      note = fmt::format("robot moved up to z = {:.3f} m", z_safe);
-    } else {
-      note = fmt::format("robot already at a safe height (z = {:.3f} m)", X_BinTcpNow.translation().z());
-    }
-    result.moved_up = true;
-    return note;
-  } catch (const std::exception& e) {
-    return fmt::format("robot could not move up ({})", e.what());
-  }
 }
 
 }  // namespace tubepick::cell

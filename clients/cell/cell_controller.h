@@ -39,7 +39,7 @@ enum class CellState {
   kNudge,        ///< no executable plan: drag a tube lying along a wall towards the middle
   kRelease,      ///< open after nothing was grasped / lifted
   kHome,         ///< back to the home pose
-  kSafeStop,     ///< open the gripper and move up, if possible
+  kSafeStop,     ///< holding a tube: back over the bin, release there if possible; else stop where it is
 };
 
 /// "start", "bias", "scan", ...
@@ -51,6 +51,25 @@ struct CellDevices {
   devices::Robot* robot = nullptr;
   devices::Gripper* gripper = nullptr;
   devices::ForceTorqueSensor* ft_sensor = nullptr;
+};
+
+/// What the gripper holds, as far as the controller knows. kUnknown (a close that did not report,
+/// a slip check that failed) is treated as holding.
+enum class Held { kNothing, kTube, kUnknown };
+/// "nothing", "tube", "unknown".
+std::string ToString(Held held);
+
+/// What a safe stop did. Holding a tube, the controller never opens the gripper outside the bin's
+/// interior: it moves the tube back over the bin, lowers it to the release height and opens there;
+/// when the arm cannot move it keeps the gripper closed and says where the tube is held.
+struct SafeStopOutcome {
+  /// What the gripper held when the fault stopped the run.
+  Held held = Held::kNothing;
+  /// "stopped" (nothing held: no motion), "released_in_bin" (moved over the bin and opened),
+  /// "kept_closed" (the arm could not move, or the gripper could not open: the tube is still held).
+  std::string action = "stopped";
+  /// The TCP where the safe stop ended, bin frame (nullopt: the robot did not report it).
+  std::optional<Eigen::Vector3d> p_Bin_tcp;
 };
 
 /// How a run ended.
@@ -72,11 +91,14 @@ struct CellRunResult {
   std::uint32_t scans = 0;
   /// Nudges (NudgeParams) performed.
   std::uint32_t nudges = 0;
+  /// Tubes lost between the grasp and the place pose (slips and drops), each recorded as "lost".
+  std::uint32_t lost = 0;
+  /// AnalyzeWrench calls answered by the local fallback (the planner unreachable while holding).
+  std::uint32_t local_analyses = 0;
   /// Set when reason == kFault.
   std::optional<CellFault> fault;
-  /// Safe stop: whether the gripper could be opened and the robot moved up.
-  bool gripper_opened = false;
-  bool moved_up = false;
+  /// Set when reason == kFault: what the safe stop did with what the gripper held.
+  std::optional<SafeStopOutcome> safe_stop;
 };
 
 /// The cell controller: runs the pick-and-place cycle of the thesis (§5.1-5.2) until the bin is
@@ -85,11 +107,25 @@ struct CellRunResult {
 ///   start → bias F/T → [scan → PlanPick → bin empty? end
 ///     → approach (pre-grasp, open to the grasp width) → F/T reference → grasp → object detected?
 ///         no: open, count a failed grasp, next plan of the same scan or rescan
-///     → lift along the waypoints → read F/T → AnalyzeWrench
-///         SINGLE: place, open, count the pick
+///     → lift along the waypoints → object still held? → read F/T → AnalyzeWrench
+///         SINGLE: transit to above the place pose (object status after every segment), a reading
+///           there must still weigh a tube, down, object status, open, count the pick
 ///         NONE: open, rescan
 ///         MULTIPLE: resolution motions in order (back to the lift pose, re-read, re-analyse after
 ///           each) → single: place; still several: lower into the bin, open, rescan] → ...
+///
+/// A tube that slips out between the grasp and the place (the gripper stops reporting an object,
+/// or the load above the place pose is gone) is recorded as "lost" with where and when, and the
+/// round goes on with a rescan: never counted as picked. AnalyzeWrench that cannot reach the planner
+/// (UNAVAILABLE after the client's retries) runs the same analysis locally (LocalAnalyzeWrench) and
+/// the record says so ("analysis_fallback"). A timed-out F/T reading is read again, readings far
+/// from the median are dropped as spikes, a timed-out or empty scan is scanned again.
+///
+/// Faults end in a safe stop that knows what the gripper holds (Held): with nothing held the arm
+/// stops where it is; holding a tube (or not sure: a close that faulted) it goes up, over the
+/// bin's middle, down to safe_release_height and opens there; when the arm cannot move or the
+/// gripper cannot open it keeps the gripper closed and reports where the tube is held. The gripper
+/// is never opened with a tube outside the bin, except on the place pose.
 ///
 /// The F/T reference is taken per attempt at the pre-grasp pose (gripper empty, already in the
 /// grasp orientation), which is the thesis' "reference with no object held" without the drift and
@@ -109,16 +145,17 @@ struct CellRunResult {
 ///   opening_width}, gripper (status after closing), wrench {reference, lift, after_resolution[]},
 ///   analysis {outcome, tube_ratio, held_weight, estimated_count, motions}, resolution {available,
 ///   used, succeeded}, result ("picked", "multiple_returned", "none", "grasp_failed", "no_plan",
-///   "nudge", "fault"), nudge {tube, contact, wall_distance, direction, shift, distance, tcp_pose}
-///   (result "nudge"), fault {device, kind, state, error}, durations {planning_wall_s, planning_server_s,
-///   analysis_wall_s, robot_wall_s, robot_device_s, attempt_wall_s, attempt_device_s},
-///   truth_before / truth_after (the annotator's object, when set).
+///   "nudge", "lost", "fault"), lost {state, detected_by, detail, device_time_s, p_Bin_tcp} (result
+///   "lost"), analysis_fallback {local_analyses, planner_error}, nudge {tube, contact, wall_distance,
+///   direction, shift, distance, tcp_pose} (result "nudge"), fault {device, kind, state, error}, durations
+///   {planning_wall_s, planning_server_s, analysis_wall_s, robot_wall_s, robot_device_s, attempt_wall_s,
+///   attempt_device_s}, truth_before / truth_after (the annotator's object, when set).
 /// A safe stop writes {"type": "safe_stop", ...}; every run ends with {"type": "end", reason,
 /// message, picks, attempts, scans, nudges, truth}.
 ///
 /// Poses are named for their frames: X_BinTcp… is a TCP pose in the bin frame (X_BinTcpGrasp,
 /// X_BinTcpPreGrasp, X_BinTcpLift, X_BinTcpPlace, X_BinHome), p_Bin_… a position in it. The source
-/// is cut by step: cell_controller.cc (the run: start, scan, plan, attempts, nudge, safe stop),
+/// is cut by step: cell_controller.cc (the run: start, scan, plan, attempts, nudge), cell_safe_stop.cc,
 /// cell_attempt.cc (one attempt: approach … place / resolve / put back), cell_device_calls.cc (the
 /// device and planner calls), attempt_record.cc (the records' parts).
 class CellController {
@@ -133,6 +170,9 @@ class CellController {
   /// record as truth_before / truth_after.
   void set_annotator(std::function<nlohmann::json()> annotator) { annotator_ = std::move(annotator); }
 
+  /// Called on every state the controller enters (a fault injector, a monitor); on the run's thread.
+  void set_state_observer(std::function<void(CellState)> observer) { observer_ = std::move(observer); }
+
   /// Runs one bin. Never throws for device or planner failures: they end in a safe stop and a
   /// kFault result.
   CellRunResult Run(std::uint32_t round = 0);
@@ -145,7 +185,8 @@ class CellController {
   struct RunState;     ///< one run's counters, result and the attempt under way
   struct PlannedScan;  ///< one scan and the planner's answer to it
   struct PlanPoses;    ///< the TCP poses of one plan, bin frame
-  enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed };
+  enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed, kLost };
+  struct TubeLost;  ///< thrown inside an attempt when the held tube is gone
 
   // The run (cell_controller.cc): start, then scan → plan → attempts or a nudge, until a stop.
   void StartCell();
@@ -172,8 +213,11 @@ class CellController {
   /// The attempt under way when `fault` stopped the run, recorded as "fault".
   void RecordFaultedAttempt(RunState& run, const CellFault& fault);
   void SafeStop(const CellFault& fault, CellRunResult& result);
-  std::string SafeStopOpenGripper(CellRunResult& result);
-  std::string SafeStopMoveUp(CellRunResult& result);
+  /// Holding: over the bin, down to the release height, open, up; says what it did and could not.
+  std::string ReturnHeldTubeToBin(SafeStopOutcome& outcome);
+  /// The release pose over the bin's middle, x_Tcp turned (about the vertical) along the bin's long
+  /// side so that the held tube hangs along it.
+  Eigen::Isometry3d SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const;
 
   // One picking attempt (cell_attempt.cc): approach, reference, grasp, lift, analyze, then place,
   // resolve or put back.
@@ -193,14 +237,21 @@ class CellController {
                                         const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
   /// SINGLE: place; NONE: release; MULTIPLE: nullopt (resolve).
   std::optional<AttemptResult> Conclude(v1::HeldOutcome outcome, const Eigen::Isometry3d& X_BinTcpPlace,
-                                        Attempt& attempt);
+                                        const devices::WrenchReading& reference, Attempt& attempt);
   AttemptResult Resolve(const v1::AnalyzeWrenchResponse& analysis, const devices::WrenchReading& reference,
                         const PlanPoses& poses, const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
   /// Resolution motion `m`, back to the lift pose, a new reading and its analysis.
   v1::AnalyzeWrenchResponse ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                              const devices::WrenchReading& reference,
                                              const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
-  void Place(const Eigen::Isometry3d& X_BinTcpPlace, Attempt& attempt);
+  void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
+             Attempt& attempt);
+  /// The gripper still reports the object (Robotiq gOBJ 2); throws TubeLost naming `where` if not.
+  void CheckStillHolding(const char* where, Attempt& attempt);
+  /// The load at the pose above the place pose still weighs a tube; throws TubeLost if not.
+  void CheckLoadBeforePlace(const devices::WrenchReading& reference, Attempt& attempt);
+  /// The tube is gone: record where and when, open (the fingers closed on nothing), home.
+  void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);
   /// Several tubes held after every resolution motion: lower them back into the bin and open.
   void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
@@ -218,12 +269,18 @@ class CellController {
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed, Attempt* attempt);
   Eigen::Isometry3d CurrentPose();
-  /// Up to transit height, across, down to `X_BinTcp`.
-  void TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt);
+  /// Up to transit height, across, down to `X_BinTcp`; `after_each` (if set) runs after every segment.
+  void TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt,
+                 const std::function<void()>& after_each = {});
   devices::GripperStatus CheckGripper(const devices::GripperStatus& status);
   void OpenGripper();
   devices::GripperStatus CloseGripper();
+  /// Mean of params.ft_samples readings after the settle samples; a timed-out read is retried
+  /// (params.ft_read_retries), readings off the median by more than the spike limits are dropped.
   devices::WrenchReading ReadWrench();
+  devices::WrenchReading ReadOneWrench();
+  /// AnalyzeWrench on the planner; when it cannot be reached (UNAVAILABLE after the client's
+  /// retries, DEADLINE_EXCEEDED) the same analysis runs here, and the record says so.
   v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,
                                     const devices::WrenchReading& current,
                                     const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
@@ -239,7 +296,9 @@ class CellController {
   RecordSink* sink_;
   std::function<double()> device_clock_;
   std::function<nlohmann::json()> annotator_;
+  std::function<void(CellState)> observer_;
   CellState state_ = CellState::kStart;
+  Held held_ = Held::kUnknown;
   std::uint32_t round_ = 0;
 };
 

@@ -86,6 +86,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
+  v("safe_release_height", p.safe_release_height,
+    "m above the bin floor: a safe stop holding a tube opens there, over the bin's middle");
   v.OptionalPose("home_pose_in_bin", p.X_BinHome,
                  "where the robot waits while the bin is scanned (X_BinHome);\n"
                  "null: above the place frame at transit height, TCP down");
@@ -133,6 +135,11 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
   v.Heading("force/torque");
   v("ft_settle_samples", p.ft_settle_samples, "readings discarded first");
   v("ft_samples", p.ft_samples, "readings averaged");
+  v("ft_read_retries", p.ft_read_retries, "tries again after a reading timed out");
+  v("ft_spike_force", p.ft_spike_force, "N off the median: a spike, dropped");
+  v("ft_spike_torque", p.ft_spike_torque, "N*m off the median: a spike, dropped");
+  v.Heading("scanner");
+  v("scan_retries", p.scan_retries, "scans again after a timeout or an empty scan");
   DescribePlannerFields(v, p);
   DescribeLimitFields(v, p);
 }

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -70,9 +71,19 @@ struct CellController::Attempt {
   double robot_wall_s = 0.0;
   double robot_device_s = 0.0;
   double analysis_wall_s = 0.0;
+  /// AnalyzeWrench calls the local fallback answered.
+  std::uint32_t local_analyses = 0;
   detail::Clock::time_point started = detail::Clock::now();
   double device_started = 0.0;
   std::optional<AttemptResult> result;
+};
+
+/// The held tube is gone (a slip, a drop): where it was noticed and by what.
+struct CellController::TubeLost : std::runtime_error {
+  TubeLost(std::string state_in, std::string detected_by_in, const std::string& detail)
+      : std::runtime_error(detail), state(std::move(state_in)), detected_by(std::move(detected_by_in)) {}
+  std::string state;
+  std::string detected_by;  ///< "gripper_status" or "wrench"
 };
 
 /// One run (one bin): its result so far, the counters the attempt limits look at and the attempt

@@ -53,6 +53,7 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
+  RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
     throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");
   // The same ranges as the planner's planning.tool (PlanningParams::Validate).
@@ -80,6 +81,8 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(gripper_speed, "gripper_speed");
   RequirePositiveValue(gripper_force, "gripper_force");
   RequirePositiveCount(ft_samples, "ft_samples");
+  RequirePositiveValue(ft_spike_force, "ft_spike_force");
+  RequirePositiveValue(ft_spike_torque, "ft_spike_torque");
   RequirePositiveCount(max_plans_per_scan, "max_plans_per_scan");
   RequirePositiveDuration(plan_deadline, "plan_deadline");
   RequirePositiveDuration(analyze_deadline, "analyze_deadline");

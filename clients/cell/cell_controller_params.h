@@ -38,6 +38,10 @@ struct CellControllerParams {
   /// Several tubes that the resolution could not shake off are lowered back to this height above
   /// the grasp point before the gripper opens, metres.
   double release_height = 0.03;
+  /// Safe stop while holding a tube: the TCP goes over the bin's middle and down to this height
+  /// above the bin floor before the gripper opens (below the wall top: the tube falls inside),
+  /// metres.
+  double safe_release_height = 0.15;
   /// The place pose is approached from this far above it, metres.
   double place_approach_height = 0.10;
   /// Where the robot waits while the bin is scanned (out of the scanner's view). Absent: above the
@@ -63,6 +67,16 @@ struct CellControllerParams {
   std::uint32_t ft_settle_samples = 4;
   /// Readings averaged for each F/T measurement (reference and after the lift).
   std::uint32_t ft_samples = 5;
+  /// Further tries of one reading that timed out (a lost RDT datagram) before it is a fault.
+  std::uint32_t ft_read_retries = 2;
+  /// A reading whose force (N) or torque (N·m) is farther than this from the measurement's median
+  /// is a spike and dropped; more than half dropped is a fault.
+  double ft_spike_force = 2.0;
+  double ft_spike_torque = 0.2;
+
+  // --- scanner ---
+  /// Further scans after a scan that timed out or returned no point, before it is a fault.
+  std::uint32_t scan_retries = 2;
 
   // --- planner ---
   /// Parameter profile sent with PlanPick ("" = the server's).

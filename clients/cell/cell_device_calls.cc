@@ -2,15 +2,33 @@
 // failures become a CellFault naming the device and the state.
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/local_wrench_analysis.h"
 #include "core/common/errors.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::cell {
+namespace {
+
+/// Per-axis median of one field of the readings.
+Eigen::Vector3d MedianOf(const std::vector<devices::WrenchReading>& readings,
+                         Eigen::Vector3d devices::WrenchReading::*field) {
+  Eigen::Vector3d median;
+  std::vector<double> values(readings.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::size_t i = 0; i < readings.size(); ++i) values[i] = (readings[i].*field)[axis];
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    median[axis] = values[values.size() / 2];
+  }
+  return median;
+}
+
+}  // namespace
 
 using detail::CallDevice;
 using detail::CallPlanner;
@@ -27,8 +45,29 @@ Eigen::Isometry3d detail::PlannerPose(const v1::Pose& pose, const std::string& f
   }
 }
 
+/// A timed-out or empty scan is tried again (params.scan_retries); an empty bin still returns
+/// the bin floor's points, so "no point at all" is a scanner failure, never "bin empty".
 devices::Capture CellController::Scan() {
-  return CallDevice("scanner", state_, [&] { return devices_.scanner->Scan(params_.scanner_timeout); });
+  for (std::uint32_t attempt = 0;; ++attempt) {
+    const bool last = attempt >= params_.scan_retries;
+    try {
+      devices::Capture capture = devices_.scanner->Scan(params_.scanner_timeout);
+      if (!capture.points_Sensor.empty()) return capture;
+      if (last)
+        throw CellFault("scanner", FaultKind::kDeviceFault, ToString(state_),
+                        fmt::format("{} scans in a row returned no point (is the projector on, the "
+                                    "exposure right, the bin in view?)",
+                                    attempt + 1));
+      spdlog::warn("cell: scan returned no point; scanning again ({} of {} retries)", attempt + 1,
+                   params_.scan_retries);
+    } catch (const devices::DeviceTimeout& e) {
+      if (last) throw CellFault("scanner", FaultKind::kTimeout, ToString(state_), e.what());
+      spdlog::warn("cell: scan timed out ({}); scanning again ({} of {} retries)", e.what(), attempt + 1,
+                   params_.scan_retries);
+    } catch (const devices::DeviceFault& e) {
+      throw CellFault("scanner", FaultKind::kDeviceFault, ToString(state_), e.what());
+    }
+  }
 }
 
 template <typename Motion>
@@ -56,14 +95,18 @@ Eigen::Isometry3d CellController::CurrentPose() {
   return CallDevice("robot", state_, [&] { return devices_.robot->CurrentPose(params_.robot_timeout); });
 }
 
-void CellController::TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt) {
+void CellController::TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt,
+                               const std::function<void()>& after_each) {
   const Eigen::Isometry3d X_BinTcpNow = CurrentPose();
   const double z_transit =
       std::max({TransitHeight(params_, cell_), X_BinTcpNow.translation().z(), X_BinTcp.translation().z()});
-  if (X_BinTcpNow.translation().z() < z_transit - kSameHeight)
-    MoveTo(WithHeight(X_BinTcpNow, z_transit), params_.transit_speed, attempt);
-  MoveTo(WithHeight(X_BinTcp, z_transit), params_.transit_speed, attempt);
-  if (X_BinTcp.translation().z() < z_transit - kSameHeight) MoveTo(X_BinTcp, params_.transit_speed, attempt);
+  const auto segment = [&](const Eigen::Isometry3d& X_BinTcpTo) {
+    MoveTo(X_BinTcpTo, params_.transit_speed, attempt);
+    if (after_each) after_each();
+  };
+  if (X_BinTcpNow.translation().z() < z_transit - kSameHeight) segment(WithHeight(X_BinTcpNow, z_transit));
+  segment(WithHeight(X_BinTcp, z_transit));
+  if (X_BinTcp.translation().z() < z_transit - kSameHeight) segment(X_BinTcp);
 }
 
 devices::GripperStatus CellController::CheckGripper(const devices::GripperStatus& status) {
@@ -77,6 +120,7 @@ devices::GripperStatus CellController::CheckGripper(const devices::GripperStatus
 void CellController::OpenGripper() {
   CheckGripper(
       CallDevice("gripper", state_, [&] { return devices_.gripper->Open(params_.gripper_timeout); }));
+  held_ = Held::kNothing;
 }
 
 devices::GripperStatus CellController::CloseGripper() {
@@ -85,19 +129,44 @@ devices::GripperStatus CellController::CloseGripper() {
   }));
 }
 
+devices::WrenchReading CellController::ReadOneWrench() {
+  for (std::uint32_t attempt = 0;; ++attempt) {
+    try {
+      return CallDevice("ft_sensor", state_, [&] { return devices_.ft_sensor->Read(params_.ft_timeout); });
+    } catch (const CellFault& fault) {
+      if (fault.kind() != FaultKind::kTimeout || attempt >= params_.ft_read_retries) throw;
+      spdlog::warn("cell: F/T reading timed out ({}); reading again", fault.error());
+    }
+  }
+}
+
 devices::WrenchReading CellController::ReadWrench() {
-  for (std::uint32_t i = 0; i < params_.ft_settle_samples; ++i)
-    CallDevice("ft_sensor", state_, [&] { return devices_.ft_sensor->Read(params_.ft_timeout); });
+  for (std::uint32_t i = 0; i < params_.ft_settle_samples; ++i) ReadOneWrench();
+  std::vector<devices::WrenchReading> readings;
+  for (std::uint32_t i = 0; i < params_.ft_samples; ++i) readings.push_back(ReadOneWrench());
+  const Eigen::Vector3d force_median = MedianOf(readings, &devices::WrenchReading::force);
+  const Eigen::Vector3d torque_median = MedianOf(readings, &devices::WrenchReading::torque);
   devices::WrenchReading mean;
-  for (std::uint32_t i = 0; i < params_.ft_samples; ++i) {
-    const devices::WrenchReading r =
-        CallDevice("ft_sensor", state_, [&] { return devices_.ft_sensor->Read(params_.ft_timeout); });
+  std::uint32_t kept = 0;
+  for (const devices::WrenchReading& r : readings) {
+    if ((r.force - force_median).norm() > params_.ft_spike_force ||
+        (r.torque - torque_median).norm() > params_.ft_spike_torque)
+      continue;
     mean.force += r.force;
     mean.torque += r.torque;
     mean.sequence = r.sequence;
+    ++kept;
   }
-  mean.force /= params_.ft_samples;
-  mean.torque /= params_.ft_samples;
+  if (2 * kept <= readings.size())
+    throw CellFault("ft_sensor", FaultKind::kDeviceFault, ToString(state_),
+                    fmt::format("{} of {} readings are more than {} N / {} N*m off their median (a loose "
+                                "cable, a hit tool, a saturated gauge?)",
+                                readings.size() - kept, readings.size(), params_.ft_spike_force,
+                                params_.ft_spike_torque));
+  if (kept < readings.size())
+    spdlog::warn("cell: {} F/T spike(s) dropped of {} readings", readings.size() - kept, readings.size());
+  mean.force /= kept;
+  mean.torque /= kept;
   return mean;
 }
 
@@ -111,8 +180,18 @@ v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& 
   *request.mutable_tcp_pose() = ToProto(X_BinTcpLift);
   request.set_variant(params_.resolution_variant);
   const Clock::time_point start = Clock::now();
-  v1::AnalyzeWrenchResponse response =
-      CallPlanner(state_, [&] { return planner_.AnalyzeWrench(request, params_.analyze_deadline); });
+  v1::AnalyzeWrenchResponse response;
+  try {
+    response = CallPlanner(state_, [&] { return planner_.AnalyzeWrench(request, params_.analyze_deadline); });
+  } catch (const CellFault& fault) {
+    if (fault.kind() != FaultKind::kServerUnavailable) throw;
+    // A tube is held: the analysis runs here rather than ending the run with the tube in the air.
+    spdlog::warn("cell: AnalyzeWrench unavailable ({}); analysing locally", fault.error());
+    response = LocalAnalyzeWrench(request, params_.profile);
+    nlohmann::json& fallback = attempt.record["analysis_fallback"];
+    fallback["local_analyses"] = ++attempt.local_analyses;
+    fallback["planner_error"] = fault.error();
+  }
   attempt.analysis_wall_s += SecondsSince(start);
   if (response.outcome() != v1::HELD_OUTCOME_NONE && response.outcome() != v1::HELD_OUTCOME_SINGLE &&
       response.outcome() != v1::HELD_OUTCOME_MULTIPLE)

@@ -106,6 +106,7 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
       ++s.attempts;
       ++c.attempts;
       if (result == "grasp_failed") ++s.grasp_failures;
+      if (result == "lost") ++s.lost_in_transit;
 
       const std::string kind = r.value("trajectory_kind", "upward");
       const bool escape = kind == "escape" || kind == "occlusion_escape";
@@ -178,6 +179,7 @@ json StatisticsJson(const CellStatistics& s) {
           {"attempts", s.attempts},
           {"no_plan_scans", s.no_plan_scans},
           {"grasp_failures", s.grasp_failures},
+          {"lost_in_transit", s.lost_in_transit},
           {"first_try_rate", s.FirstTryRate()},
           {"simulated_attempts", s.simulated_attempts},
           {"by_tubes_in_bin", by_count},

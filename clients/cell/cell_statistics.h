@@ -65,6 +65,8 @@ struct CellStatistics {
   std::uint32_t attempts = 0;
   std::uint32_t no_plan_scans = 0;
   std::uint32_t grasp_failures = 0;
+  /// Attempts whose tube the controller saw slip out between grasp and place ("lost").
+  std::uint32_t lost_in_transit = 0;
   /// Attempts whose plan used simulation (Table 5.6 "usage rate (total)").
   std::uint32_t simulated_attempts = 0;
   /// By tubes in the bin, largest first.

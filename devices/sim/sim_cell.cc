@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "devices/sim/sim_devices.h"
@@ -39,6 +40,41 @@ std::vector<physics::TubeGeometry> GenerateTubes(const SimCellParams& p) {
   return drop.tubes;
 }
 
+/// A tube's centre of mass inside the bin: the inner footprint, from the floor to the wall top (each
+/// with kCountMargin).
+bool InBin(const Eigen::Vector3d& p, const BinConfig& bin) {
+  const Eigen::Vector3d& size = bin.inner_size;
+  return std::abs(p.x()) <= 0.5 * size.x() && std::abs(p.y()) <= 0.5 * size.y() && p.z() >= -kCountMargin &&
+         p.z() <= size.z() + kCountMargin;
+}
+
+/// Outside the inner footprint, not above the wall top + kCountMargin (on the floor, a table, a wall).
+bool BesideBin(const Eigen::Vector3d& p, const BinConfig& bin) {
+  const Eigen::Vector3d& size = bin.inner_size;
+  const bool beside = std::abs(p.x()) > 0.5 * size.x() || std::abs(p.y()) > 0.5 * size.y();
+  return beside && p.z() <= size.z() + kCountMargin;
+}
+
+/// Over the place zone: zone_size (x_Bin, y_Bin) centred under the place frame's origin.
+bool OverPlaceZone(const Eigen::Vector3d& p, const CellConfig& cell, const Eigen::Vector2d& zone_size) {
+  const Eigen::Vector3d centre = cell.place.X_BinPlace.translation();
+  return std::abs(p.x() - centre.x()) <= 0.5 * zone_size.x() &&
+         std::abs(p.y() - centre.y()) <= 0.5 * zone_size.y();
+}
+
+/// Tubes whose centre of mass satisfies `where`; held ones only when `with_held`.
+template <typename Where>
+std::uint32_t CountTubes(const SimCellState& state, bool with_held, const Where& where) {
+  const SimWorld& world = *state.world;
+  const std::vector<std::size_t> held = world.HeldTubes();
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < world.tube_count(); ++i) {
+    if (!with_held && std::binary_search(held.begin(), held.end(), i)) continue;
+    if (where(world.TubeCentreOfMass(i))) ++count;
+  }
+  return count;
+}
+
 const SimCellParams& Validated(const SimCellParams& params) {
   params.Validate();
   return params;
@@ -66,19 +102,50 @@ SimCellState::SimCellState(const SimCellParams& p, const std::vector<physics::Tu
 }
 
 void SimCellState::ThrowIfInjected(SimDevice device, const std::string& who) const {
-  switch (faults[static_cast<int>(device)]) {
-    case SimFault::kNone:
-      return;
-    case SimFault::kTimeout:
-      throw DeviceTimeout(who + ": no answer (injected timeout)");
-    case SimFault::kFault:
-      throw DeviceFault(who + ": fault (injected)");
+  const int d = static_cast<int>(device);
+  const SimFault fault = faults[d];
+  if (fault == SimFault::kNone) return;
+  if (fault_once[d]) {
+    faults[d] = SimFault::kNone;
+    fault_once[d] = false;
   }
+  ++const_cast<SimFaultEvents&>(events).device_failures;
+  if (fault == SimFault::kTimeout) throw DeviceTimeout(who + ": no answer (injected timeout)");
+  throw DeviceFault(who + ": fault (injected)");
+}
+
+void SimCellState::TickSlip(double dt) {
+  if (slip_in < 0.0) return;
+  slip_in -= dt;
+  if (slip_in > 0.0) return;
+  slip_in = -1.0;
+  if (!world->holding()) return;
+  world->ReleaseAll();
+  gripper_object = GripperObject::kAtPosition;
+  ++events.slips;
+  spdlog::debug("sim cell: the held tube slipped out at {:.3f} {:.3f} {:.3f}",
+                world->X_BinTcp().translation().x(), world->X_BinTcp().translation().y(),
+                world->X_BinTcp().translation().z());
+}
+
+void SimCellState::TickRobotAlarm(double dt) {
+  if (robot_alarm_in < 0.0) return;
+  robot_alarm_in -= dt;
+  if (robot_alarm_in > 0.0) return;
+  robot_alarm_in = -1.0;
+  servo_on = false;
+  ++events.robot_alarms;
+  const Eigen::Vector3d p = world->X_BinTcp().translation();
+  throw DeviceFault(fmt::format(
+      "robot: alarm 4100 (injected: overrun) at ({:.3f}, {:.3f}, {:.3f}) m; servo off", p.x(), p.y(), p.z()));
 }
 
 void SimCellState::Advance(double seconds) {
   const int steps = static_cast<int>(std::ceil(seconds / params.physics.time_step - 1e-9));
-  for (int i = 0; i < steps; ++i) world->ControlStep();
+  for (int i = 0; i < steps; ++i) {
+    world->ControlStep();
+    TickSlip(params.physics.time_step);
+  }
 }
 
 Wrench SimCellState::RawFtReading() {
@@ -124,31 +191,24 @@ const CellConfig& SimCell::cell() const { return impl_->state.params.cell; }
 const SimCellParams& SimCell::params() const { return impl_->state.params; }
 
 std::uint32_t SimCell::TubesInBin() const {
-  const SimWorld& world = *impl_->state.world;
-  const Eigen::Vector3d& size = cell().bin.inner_size;
-  std::uint32_t count = 0;
-  for (std::size_t i = 0; i < world.tube_count(); ++i) {
-    const Eigen::Vector3d p = world.TubeCentreOfMass(i);
-    if (std::abs(p.x()) <= 0.5 * size.x() && std::abs(p.y()) <= 0.5 * size.y() && p.z() >= -kCountMargin &&
-        p.z() <= size.z() + kCountMargin) {
-      ++count;
-    }
-  }
-  return count;
+  return CountTubes(impl_->state, true, [&](const Eigen::Vector3d& p) { return InBin(p, cell().bin); });
 }
 
 std::uint32_t SimCell::TubesOutsideBin() const {
-  const SimWorld& world = *impl_->state.world;
-  const Eigen::Vector3d& size = cell().bin.inner_size;
-  const std::vector<std::size_t> held = world.HeldTubes();
-  std::uint32_t count = 0;
-  for (std::size_t i = 0; i < world.tube_count(); ++i) {
-    if (std::binary_search(held.begin(), held.end(), i)) continue;
-    const Eigen::Vector3d p = world.TubeCentreOfMass(i);
-    const bool beside = std::abs(p.x()) > 0.5 * size.x() || std::abs(p.y()) > 0.5 * size.y();
-    if (beside && p.z() <= size.z() + kCountMargin) ++count;
-  }
-  return count;
+  return CountTubes(impl_->state, false, [&](const Eigen::Vector3d& p) { return BesideBin(p, cell().bin); });
+}
+
+std::uint32_t SimCell::TubesInPlaceZone() const {
+  return CountTubes(impl_->state, false, [&](const Eigen::Vector3d& p) {
+    return BesideBin(p, cell().bin) && OverPlaceZone(p, cell(), params().place_zone_size);
+  });
+}
+
+std::uint32_t SimCell::TubesElsewhere() const {
+  return CountTubes(impl_->state, false, [&](const Eigen::Vector3d& p) {
+    return !InBin(p, cell().bin) &&
+           !(BesideBin(p, cell().bin) && OverPlaceZone(p, cell(), params().place_zone_size));
+  });
 }
 
 double SimCell::SimulatedSeconds() const { return impl_->state.world->time() - impl_->state.start_time; }
@@ -173,7 +233,19 @@ void SimCell::Advance(double seconds) { impl_->state.Advance(seconds); }
 
 void SimCell::InjectFault(SimDevice device, SimFault fault) {
   impl_->state.faults[static_cast<int>(device)] = fault;
+  impl_->state.fault_once[static_cast<int>(device)] = false;
 }
+
+void SimCell::InjectFaultOnce(SimDevice device, SimFault fault) {
+  impl_->state.faults[static_cast<int>(device)] = fault;
+  impl_->state.fault_once[static_cast<int>(device)] = fault != SimFault::kNone;
+}
+
+void SimCell::ArmRobotAlarm(double seconds) { impl_->state.robot_alarm_in = std::max(0.0, seconds); }
+void SimCell::ArmSlip(double seconds) { impl_->state.slip_in = std::max(0.0, seconds); }
+void SimCell::InjectFtSpike() { impl_->state.ft_spike_next = true; }
+void SimCell::InjectEmptyScan() { impl_->state.empty_scan_next = true; }
+const SimFaultEvents& SimCell::fault_events() const { return impl_->state.events; }
 
 bool SimCell::settled() const { return impl_->state.settled; }
 

@@ -174,6 +174,11 @@ struct SimCellParams {
   /// Tube shapes (Algorithm 2); nullopt = set A (pvc) or set B (rubber) with cell.tube's radius and
   /// length. Only linear tubes (one branch).
   std::optional<physics::RandomTubeParams> tube_shape;
+  /// The place zone: a table or conveyor beside the bin, centred under cell.place.X_BinPlace's
+  /// origin, this size along x_Bin and y_Bin, metres. Tubes at rest in it count as placed. The
+  /// default (0.8 × 0.9 m around the thesis cell's place frame at y = 0.8 m) reaches the bin's
+  /// outer wall, so a tube that slips in transit falls into the bin or onto the zone.
+  Eigen::Vector2d place_zone_size{0.8, 0.9};
   /// The virtual scanner (its wall_thickness is the rendered walls').
   physics::ScannerParams scanner;
   SimGripperParams gripper;
@@ -195,6 +200,15 @@ enum class SimFault {
   kTimeout,
   /// The call throws DeviceFault; Gripper::Status does not throw but reports fault 0x0E.
   kFault,
+};
+
+/// Injected events that happened (not only armed).
+struct SimFaultEvents {
+  std::uint32_t robot_alarms = 0;
+  std::uint32_t slips = 0;  ///< a tube was held and fell
+  std::uint32_t ft_spikes = 0;
+  std::uint32_t empty_scans = 0;
+  std::uint32_t device_failures = 0;  ///< calls that failed by InjectFault / InjectFaultOnce
 };
 
 /// One Bullet world behind all four devices: tubes from the scene generator dropped into the bin;
@@ -248,6 +262,11 @@ class SimCell {
   /// Tubes outside the bin (centre of mass outside the inner footprint, below the wall top + 5 cm)
   /// and not held by the gripper: placed or lost.
   std::uint32_t TubesOutsideBin() const;
+  /// Tubes outside the bin whose centre of mass lies over the place zone (SimCellParams::place_zone_size).
+  std::uint32_t TubesInPlaceZone() const;
+  /// Tubes neither in the bin, nor in the place zone, nor held: on the floor, on a wall, anywhere a
+  /// tube must never be released.
+  std::uint32_t TubesElsewhere() const;
   /// Simulated seconds since construction (the initial drop and settling not counted).
   double SimulatedSeconds() const;
 
@@ -266,6 +285,21 @@ class SimCell {
   void Advance(double seconds);
   /// Every following call to `device` fails as `fault` says, until injected kNone again.
   void InjectFault(SimDevice device, SimFault fault);
+  /// The next call to `device` fails as `fault` says; the calls after it work again.
+  void InjectFaultOnce(SimDevice device, SimFault fault);
+  /// After `seconds` more of simulated robot motion the robot stops with an alarm (servo off,
+  /// DeviceFault), wherever it is; it stays off (the cell needs an operator).
+  void ArmRobotAlarm(double seconds);
+  /// After `seconds` more of simulated time (motion, readings, scans) whatever the gripper holds
+  /// slips out and falls in the world; the gripper then reports no object. Opening the gripper
+  /// first disarms it.
+  void ArmSlip(double seconds);
+  /// The next F/T reading carries a 25 N spike along z (a hit cable, an EMI burst).
+  void InjectFtSpike();
+  /// The next scan returns no point (a projector or exposure failure).
+  void InjectEmptyScan();
+  /// The injected events that happened so far.
+  const SimFaultEvents& fault_events() const;
   /// The tubes were at rest when construction ended (false: settle_time ran out).
   bool settled() const;
 

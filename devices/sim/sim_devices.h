@@ -27,7 +27,15 @@ struct SimCellState {
   bool servo_on = false;
   bool gripper_activated = false;
   GripperObject gripper_object = GripperObject::kAtPosition;
-  std::array<SimFault, 4> faults{SimFault::kNone, SimFault::kNone, SimFault::kNone, SimFault::kNone};
+  mutable std::array<SimFault, 4> faults{SimFault::kNone, SimFault::kNone, SimFault::kNone, SimFault::kNone};
+  /// The device's injected fault clears after it failed one call.
+  mutable std::array<bool, 4> fault_once{false, false, false, false};
+  /// Armed events (SimCell::ArmRobotAlarm / ArmSlip): simulated seconds until they happen, < 0 = none.
+  double robot_alarm_in = -1.0;
+  double slip_in = -1.0;
+  bool ft_spike_next = false;
+  bool empty_scan_next = false;
+  SimFaultEvents events;
 
   /// The F/T sensor's raw reading at the last Bias (sensor frame), subtracted from every read.
   Wrench bias;
@@ -40,6 +48,11 @@ struct SimCellState {
 
   /// Throws the injected fault of `device` (`who` prefixes the message), if any.
   void ThrowIfInjected(SimDevice device, const std::string& who) const;
+  /// Advances the armed slip by `dt` simulated seconds; when it is due, whatever the gripper holds
+  /// falls (the fingers stay, the gripper reports no object).
+  void TickSlip(double dt);
+  /// Advances the armed robot alarm by `dt`; when due: servo off and DeviceFault.
+  void TickRobotAlarm(double dt);
   /// Steps whole control steps with the gripper still for at least `seconds`.
   void Advance(double seconds);
   /// Raw F/T reading averaged over the F/T window (the world advances by it): payload wrench plus

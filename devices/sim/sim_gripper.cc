@@ -59,6 +59,7 @@ GripperStatus SimGripper::MoveTo(double opening, double speed, double force, Tim
   double current = world.opening();
   if (target >= current) {  // opening (or staying): let go of whatever is held
     world.ReleaseAll();
+    state_.slip_in = -1.0;
     state_.gripper_object = GripperObject::kAtPosition;
     while (current < target) {
       tick();

@@ -86,6 +86,8 @@ void SimCellParams::Validate() const {
   Require(tubes <= 100, "tubes", tubes, "≤ 100");
   Require(force_noise >= 0.0 && Finite(force_noise), "force_noise", force_noise, "≥ 0 N");
   Require(torque_noise >= 0.0 && Finite(torque_noise), "torque_noise", torque_noise, "≥ 0 N·m");
+  Require(place_zone_size.allFinite() && place_zone_size.minCoeff() > 0.0, "place_zone_size",
+          place_zone_size.minCoeff(), "> 0 m on both axes");
   Require(force_offset.allFinite(), "force_offset", force_offset.norm(), "finite");
   Require(torque_offset.allFinite(), "torque_offset", torque_offset.norm(), "finite");
 

@@ -86,6 +86,8 @@ void SimRobot::Run(double length, double speed, const PoseAt& pose_at, const Eig
     }
     world.SetGripper(k == steps ? X_BinTcp_end : pose_at(profile.DistanceAt(t)), world.opening());
     world.Step();
+    state_.TickSlip(dt);
+    state_.TickRobotAlarm(dt);
     if (k % world.substeps() == 0 || k == steps) {
       const GripperCollision collision = world.QueryCollision(true, housing_stop);
       if (!warned) {

@@ -24,6 +24,13 @@ devices::Capture SimScanner::Scan(Timeout timeout) {
         fmt::format("scanner: a scan takes {:.2f} s, the timeout is {:.3f} s", duration, Seconds(timeout)));
   }
   state_.Advance(duration);
+  if (state_.empty_scan_next) {
+    state_.empty_scan_next = false;
+    ++state_.events.empty_scans;
+    return devices::Capture{.points_Sensor = {},
+                            .unit = state_.params.cell.sensor.unit,
+                            .X_BinSensor = state_.params.cell.sensor.X_BinSensor};
+  }
   const physics::ScanResult scan =
       physics::ScanScene(state_.world->TubesBin(), state_.params.cell, state_.params.scanner,
                          physics::DeriveSeed(state_.params.seed, kScanStream + state_.scans++));
@@ -45,6 +52,11 @@ WrenchReading SimForceTorqueSensor::Read(Timeout /*timeout*/) {
   reading.force = raw.force - state_.bias.force;
   reading.torque = raw.torque - state_.bias.torque;
   reading.sequence = ++state_.ft_sequence;
+  if (state_.ft_spike_next) {
+    state_.ft_spike_next = false;
+    ++state_.events.ft_spikes;
+    reading.force.z() += 25.0;
+  }
   return reading;
 }
 

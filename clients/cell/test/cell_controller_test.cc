@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "clients/cell/cell_statistics.h"
 #include "clients/cell/test/scripted_cell.h"
 #include "core/common/errors.h"
 
@@ -36,10 +37,13 @@ class CellControllerTest : public ::testing::Test {
   void SetUp() override {
     params.ft_samples = 1;
     params.ft_settle_samples = 0;
+    gripper.tcp = &robot.X_BinTcp;
+    ft.holding = &gripper.holding;
   }
 
   CellRunResult Run() {
     CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
+    if (observer) controller.set_state_observer(observer);
     return controller.Run(3);
   }
 
@@ -63,6 +67,7 @@ class CellControllerTest : public ::testing::Test {
   MemoryRecordSink sink;
   CellConfig cell;
   CellControllerParams params;
+  std::function<void(CellState)> observer;
   const Eigen::Vector3d p_Bin_grasp{0.1, -0.05, 0.03};
 };
 
@@ -471,35 +476,61 @@ TEST_F(CellControllerTest, PerBinLimitCountsAllAttempts) {
 
 // ---------------------------------------------------------------- faults
 
-TEST_F(CellControllerTest, ScannerTimeoutEndsInSafeStop) {
-  scanner.failures = {Failure{true, "PhoXi: no frame within 30000 ms"}};
+TEST_F(CellControllerTest, ScannerTimeoutsAfterTheRetriesEndInASafeStopWhereTheArmIs) {
+  const Failure timeout{true, "PhoXi: no frame within 30000 ms"};
+  scanner.failures = {timeout, timeout, timeout};  // the scan and its two retries
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kFault);
   ASSERT_TRUE(result.fault);
   EXPECT_EQ(result.fault->device(), "scanner");
   EXPECT_EQ(result.fault->kind(), FaultKind::kTimeout);
   EXPECT_EQ(result.fault->state(), "scan");
-  EXPECT_TRUE(result.gripper_opened);
-  EXPECT_TRUE(result.moved_up);
+  EXPECT_EQ(scanner.calls, 3);
+  // Nothing held: no motion, the gripper as it was (opened once, at the start).
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kNothing);
+  EXPECT_EQ(result.safe_stop->action, "stopped");
+  EXPECT_EQ(gripper.opens, 1);
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
   EXPECT_EQ(
       result.message.rfind("SAFE STOP: scanner timeout during scan: PhoXi: no frame within 30000 ms", 0), 0u)
       << result.message;
+  EXPECT_NE(result.message.find("nothing held: stopped where it is"), std::string::npos) << result.message;
   const json stop = Records("safe_stop").at(0);
   EXPECT_EQ(stop["device"], "scanner");
   EXPECT_EQ(stop["kind"], "timeout");
-  EXPECT_EQ(stop["gripper_opened"], true);
+  EXPECT_EQ(stop["held"], "nothing");
+  EXPECT_EQ(stop["action"], "stopped");
+  EXPECT_NEAR(stop["p_Bin_tcp"][2].get<double>(), 0.5, kTol);
   EXPECT_EQ(Records("end").at(0)["reason"], "fault");
   EXPECT_TRUE(Records("attempt").empty());
 }
 
-TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) {
+TEST_F(CellControllerTest, OneScannerTimeoutOrEmptyScanIsScannedAgain) {
+  scanner.failures = {Failure{true, "PhoXi: no frame within 30000 ms"}};
+  scanner.empty_at = {1};  // the retry returns no point, the next one works
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(scanner.calls, 3);
+  EXPECT_EQ(planner.plan_requests.size(), 1u);  // only the good scan was planned on
+}
+
+TEST_F(CellControllerTest, EmptyScansAreAScannerFaultNeverAnEmptyBin) {
+  scanner.empty_at = {0, 1, 2};
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "scanner");
+  EXPECT_NE(result.message.find("3 scans in a row returned no point"), std::string::npos) << result.message;
+  EXPECT_TRUE(planner.plan_requests.empty());
+}
+
+TEST_F(CellControllerTest, GripperFaultWhileClosingCountsAsHoldingAndReleasesOverTheBin) {
   planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   devices::GripperStatus fault;
   fault.activated = true;
   fault.fault = 0x08;
   fault.fault_text = "overcurrent";
   gripper.close_results = {fault};
-  const int opens_before_stop = 1;  // the start opens once
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kFault);
@@ -508,19 +539,27 @@ TEST_F(CellControllerTest, GripperFaultStatusEndsInSafeStopThatOpensAndMovesUp) 
   EXPECT_EQ(result.fault->kind(), FaultKind::kDeviceFault);
   EXPECT_EQ(result.fault->state(), "grasp");
   EXPECT_NE(result.message.find("fault 0x08: overcurrent"), std::string::npos) << result.message;
-  EXPECT_EQ(gripper.opens, opens_before_stop + 1);
-  EXPECT_TRUE(gripper.open);
-  // The robot was at the grasp pose in the bin; the safe stop moved it straight up to transit height.
+  // The close did not say what it holds: up to transit height, over the bin's middle, down to
+  // safe_release_height, open there, back up.
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kUnknown);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(p_Bin_grasp.x(), p_Bin_grasp.y(), 0.5))));
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.0, params.safe_release_height))));
+  ASSERT_EQ(gripper.opened_at.size(), 2u);  // the start, then the release
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
   EXPECT_NEAR(robot.X_BinTcp.translation().z(), 0.5, kTol);
-  EXPECT_NEAR(robot.X_BinTcp.translation().x(), p_Bin_grasp.x(), kTol);
-  EXPECT_NE(result.message.find("robot moved up to z = 0.500 m"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("possibly a tube released into the bin at X_BinTcp (0.000, 0.000, 0.150) m"),
+            std::string::npos)
+      << result.message;
   const json a = Records("attempt").at(0);
   EXPECT_EQ(a["result"], "fault");
   EXPECT_EQ(a["fault"]["device"], "gripper");
   EXPECT_EQ(a["fault"]["state"], "grasp");
+  EXPECT_EQ(Records("safe_stop").at(0)["held"], "unknown");
 }
 
-TEST_F(CellControllerTest, RobotFaultDuringLiftEndsInSafeStopEvenWhenTheRobotCannotMove) {
+TEST_F(CellControllerTest, RobotAlarmDuringLiftKeepsTheTubeAndSaysWhereItIsHeld) {
   planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
   robot.fail_through_from = 0;
 
@@ -530,32 +569,78 @@ TEST_F(CellControllerTest, RobotFaultDuringLiftEndsInSafeStopEvenWhenTheRobotCan
   EXPECT_EQ(result.fault->device(), "robot");
   EXPECT_EQ(result.fault->kind(), FaultKind::kDeviceFault);
   EXPECT_EQ(result.fault->state(), "lift");
-  EXPECT_TRUE(result.gripper_opened);  // the tube is released where it lies
-  EXPECT_FALSE(result.moved_up);
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kTube);
+  EXPECT_EQ(result.safe_stop->action, "kept_closed");
+  EXPECT_EQ(gripper.opens, 1);  // only the start's: the tube is not dropped where it hangs
+  EXPECT_TRUE(gripper.holding);
   EXPECT_NE(result.message.find("YRC1000 alarm 4107"), std::string::npos);
-  EXPECT_NE(result.message.find("robot could not move up"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("HOLDING a tube at X_BinTcp (0.100, -0.050, 0.030) m: the robot cannot move"),
+            std::string::npos)
+      << result.message;
   EXPECT_EQ(Records("attempt").at(0)["fault"]["device"], "robot");
-  EXPECT_EQ(Records("safe_stop").at(0)["moved_up"], false);
+  const json stop = Records("safe_stop").at(0);
+  EXPECT_EQ(stop["action"], "kept_closed");
+  EXPECT_NEAR(stop["p_Bin_tcp"][0].get<double>(), p_Bin_grasp.x(), kTol);
 }
 
-TEST_F(CellControllerTest, ForceTorqueTimeoutAfterLiftEndsInSafeStop) {
+TEST_F(CellControllerTest, ForceTorqueLostAfterLiftReturnsTheTubeIntoTheBin) {
   planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
-  ft.fail_read_from = 1;  // the reference works, the reading after the lift does not
+  ft.fail_read_from = 1;  // the reference works, every reading after the lift times out
 
   const CellRunResult result = Run();
   ASSERT_TRUE(result.fault);
   EXPECT_EQ(result.fault->device(), "ft_sensor");
   EXPECT_EQ(result.fault->kind(), FaultKind::kTimeout);
   EXPECT_EQ(result.fault->state(), "analyze");
-  EXPECT_TRUE(result.gripper_opened);
+  EXPECT_EQ(ft.reads, 1 + 1 + static_cast<int>(params.ft_read_retries));
   EXPECT_EQ(result.message.rfind("SAFE STOP: ft_sensor timeout during analyze", 0), 0u) << result.message;
   EXPECT_TRUE(planner.wrench_requests.empty());
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  ASSERT_EQ(gripper.opened_at.size(), 2u);
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
   const json a = Records("attempt").at(0);
   EXPECT_EQ(a["result"], "fault");
   EXPECT_EQ(a["gripper"]["object"], "stopped_closing");
 }
 
-TEST_F(CellControllerTest, PlannerUnavailableEndsInSafeStop) {
+TEST_F(CellControllerTest, OneForceTorqueTimeoutIsReadAgain) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  ft.fail_once_at = {1};
+  ft.readings = {Reading(0.10), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(result.picks, 1u);
+  ASSERT_EQ(planner.wrench_requests.size(), 1u);
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[0].current().force().z(), 0.64);
+}
+
+TEST_F(CellControllerTest, ForceTorqueSpikesAreDroppedFromTheMean) {
+  params.ft_samples = 5;
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  ft.readings = {Reading(0.10), Reading(0.10), Reading(0.10), Reading(0.10), Reading(0.10),
+                 Reading(0.64), Reading(25.6), Reading(0.66), Reading(0.62), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  ASSERT_EQ(planner.wrench_requests.size(), 1u);
+  EXPECT_NEAR(planner.wrench_requests[0].current().force().z(), 0.64, 1e-12);  // 25.6 N dropped
+}
+
+TEST_F(CellControllerTest, MostlySpikesAreAForceTorqueFault) {
+  params.ft_samples = 3;
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  ft.readings = {Reading(0.10), Reading(9.0), Reading(-9.0)};
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  EXPECT_EQ(result.fault->state(), "reference");
+  EXPECT_NE(result.message.find("2 of 3 readings are more than 2 N"), std::string::npos) << result.message;
+}
+
+TEST_F(CellControllerTest, PlannerUnavailableBeforeTheGraspStopsWhereTheArmIs) {
   testing::ScriptedPlanner::PlanAnswer down;
   down.error =
       PlannerError("PlanPick", grpc::StatusCode::UNAVAILABLE, "failed to connect to all addresses", 4);
@@ -569,8 +654,185 @@ TEST_F(CellControllerTest, PlannerUnavailableEndsInSafeStop) {
   EXPECT_NE(result.message.find("PlanPick failed after 4 tries: UNAVAILABLE: failed to connect"),
             std::string::npos)
       << result.message;
-  EXPECT_TRUE(result.gripper_opened);
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "stopped");
+  EXPECT_EQ(gripper.opens, 1);
   EXPECT_EQ(Records("safe_stop").at(0)["kind"], "server_unavailable");
+}
+
+TEST_F(CellControllerTest, PlannerGoneWhileHoldingAnalysesLocallyAndPlaces) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  // One 55 g tube: 0.54 N more along z_Tcp (down) after the lift.
+  ft.readings = {Reading(0.10), Reading(0.10 + cell.tube.mass * 9.81)};
+  planner.wrench_error =
+      PlannerError("AnalyzeWrench", grpc::StatusCode::UNAVAILABLE, "failed to connect to all addresses", 6);
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_EQ(result.local_analyses, 1u);
+  EXPECT_EQ(planner.wrench_requests.size(), 1u);
+  EXPECT_TRUE(robot.Visited(testing::PlacePose()));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "picked");
+  EXPECT_EQ(a["analysis"]["outcome"], "single");
+  EXPECT_EQ(a["analysis_fallback"]["local_analyses"], 1);
+  EXPECT_NE(a["analysis_fallback"]["planner_error"].get<std::string>().find("UNAVAILABLE"),
+            std::string::npos);
+}
+
+TEST_F(CellControllerTest, PlannerRejectingTheAnalysisIsStillAFault) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  planner.wrench_error =
+      PlannerError("AnalyzeWrench", grpc::StatusCode::INVALID_ARGUMENT, "tube_mass: bad", 1);
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->kind(), FaultKind::kServerError);
+  EXPECT_EQ(result.local_analyses, 0u);
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");  // holding: back into the bin
+}
+
+// ---------------------------------------------------------------- faults during place
+
+class PlaceFaultTest : public CellControllerTest {
+ protected:
+  void SetUp() override {
+    CellControllerTest::SetUp();
+    planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+    ft.readings = {Reading(0.10), Reading(0.64), Reading(0.64)};  // reference, lift, above the place
+    planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  }
+  /// Every open after the start's happened over the bin's interior, below its wall top.
+  void ExpectOpenedOnlyInTheBin() const {
+    for (std::size_t i = 1; i < gripper.opened_at.size(); ++i) {
+      const Eigen::Vector3d& p = gripper.opened_at[i];
+      EXPECT_LE(std::abs(p.x()), 0.5 * cell.bin.inner_size.x()) << i;
+      EXPECT_LE(std::abs(p.y()), 0.5 * cell.bin.inner_size.y()) << i;
+      EXPECT_LE(p.z(), cell.bin.inner_size.z()) << i;
+    }
+  }
+};
+
+TEST_F(PlaceFaultTest, RobotAlarmOnTheDescentKeepsTheTubeOverThePlaceZone) {
+  robot.alarm_on_move_to = [](const Eigen::Isometry3d& X) { return X.isApprox(testing::PlacePose(), kTol); };
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "robot");
+  EXPECT_EQ(result.fault->state(), "place");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kTube);
+  EXPECT_EQ(result.safe_stop->action, "kept_closed");
+  EXPECT_EQ(gripper.opens, 1);
+  EXPECT_TRUE(gripper.holding);
+  // Stopped above the place pose (0, 0.8, 0.12 + 0.1): that is where the operator finds the tube.
+  EXPECT_NE(result.message.find("HOLDING a tube at X_BinTcp (0.000, 0.800, 0.220) m: the robot cannot move"),
+            std::string::npos)
+      << result.message;
+  EXPECT_EQ(result.picks, 0u);
+}
+
+TEST_F(PlaceFaultTest, RobotAlarmAfterTheTubeIsPlacedStillCountsThePick) {
+  // The second move to the pose above the place is the way up after opening.
+  int above_place = 0;
+  robot.alarm_on_move_to = [&](const Eigen::Isometry3d& X) {
+    const Eigen::Isometry3d X_above =
+        DownPose(testing::PlacePose().translation() + Eigen::Vector3d(0, 0, 0.1));
+    return X.isApprox(X_above, kTol) && ++above_place == 2;
+  };
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->state(), "place");
+  EXPECT_EQ(result.picks, 1u);
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kNothing);
+  EXPECT_EQ(result.safe_stop->action, "stopped");
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "picked");
+  EXPECT_EQ(a["placed"], true);
+  EXPECT_EQ(a["fault"]["device"], "robot");
+  EXPECT_EQ(Records("end").at(0)["picks"], 1);
+}
+
+TEST_F(PlaceFaultTest, GripperThatCannotOpenAtThePlaceGoesBackOverTheBinAndSaysSo) {
+  gripper.fail_open_from = 1;  // the start's open works
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "gripper");
+  EXPECT_EQ(result.fault->state(), "place");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "kept_closed");
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.0, params.safe_release_height))));
+  EXPECT_EQ(gripper.opens, 3);  // the start, the place (failed), over the bin (failed)
+  EXPECT_NE(
+      result.message.find("HOLDING a tube over the bin at X_BinTcp (0.000, 0.000, 0.150) m: the gripper "
+                          "cannot open (Robotiq 2F-85: no Modbus reply"),
+      std::string::npos)
+      << result.message;
+}
+
+TEST_F(PlaceFaultTest, ForceTorqueLostAboveThePlaceReturnsTheTubeIntoTheBin) {
+  ft.fail_read_from = 2;  // reference and lift work; the check above the place does not
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  EXPECT_EQ(result.fault->state(), "place");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  ExpectOpenedOnlyInTheBin();
+  EXPECT_EQ(gripper.opened_at.size(), 2u);
+}
+
+TEST_F(PlaceFaultTest, PlannerGoneDuringThePlaceChangesNothing) {
+  // From the place on, every planner call fails: the place needs none (its load check runs here).
+  observer = [this](CellState state) {
+    if (state != CellState::kPlace) return;
+    planner.wrench_error =
+        PlannerError("AnalyzeWrench", grpc::StatusCode::UNAVAILABLE, "connection refused", 6);
+    testing::ScriptedPlanner::PlanAnswer down;
+    down.error = PlannerError("PlanPick", grpc::StatusCode::UNAVAILABLE, "connection refused", 6);
+    planner.plan_answers.push_back(down);
+  };
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_EQ(planner.wrench_requests.size(), 1u);  // the lift's, before the planner went
+  EXPECT_TRUE(robot.Visited(testing::PlacePose()));
+  ASSERT_EQ(gripper.opened_at.size(), 2u);  // the start's, then on the place pose only
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(testing::PlacePose().translation(), kTol));
+  EXPECT_EQ(Records("attempt").at(0)["result"], "picked");
+  // The next scan found no planner: nothing held, so the arm stops at home.
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->state(), "plan");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "stopped");
+}
+
+TEST_F(PlaceFaultTest, SlipInTransitIsRecordedAsLostAndTheRoundGoesOn) {
+  gripper.drop_at_status = 2;  // after the lift and the first transit segment it still holds
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_EQ(result.lost, 1u);
+  EXPECT_EQ(result.scans, 2u);  // rescanned after the loss
+  EXPECT_FALSE(robot.Visited(testing::PlacePose()));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "lost");
+  EXPECT_EQ(a["lost"]["state"], "place_transit");
+  EXPECT_EQ(a["lost"]["detected_by"], "gripper_status");
+  EXPECT_EQ(a["lost"]["p_Bin_tcp"].size(), 3u);
+  EXPECT_EQ(Records("end").at(0)["lost"], 1);
+  EXPECT_EQ(SummarizeRecords(sink.records()).lost_in_transit, 1u);
+}
+
+TEST_F(PlaceFaultTest, NoLoadAboveThePlaceIsALostTubeEvenWhenTheGripperSaysHolding) {
+  ft.readings = {Reading(0.10), Reading(0.64), Reading(0.11)};  // the tube is gone above the place
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.lost, 1u) << result.message;
+  EXPECT_EQ(result.picks, 0u);
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "lost");
+  EXPECT_EQ(a["lost"]["detected_by"], "wrench");
+  EXPECT_NEAR(a["wrench"]["before_place"]["force"][2].get<double>(), 0.11, 1e-12);
+  EXPECT_FALSE(robot.Visited(testing::PlacePose()));
 }
 
 TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
@@ -587,20 +849,6 @@ TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
   EXPECT_NE(result.message.find("PlanPick failed after 3 tries: UNAVAILABLE"), std::string::npos)
       << result.message;
   EXPECT_EQ(controller.state(), CellState::kSafeStop);
-}
-
-TEST_F(CellControllerTest, SafeStopSaysSoWhenTheGripperCannotOpen) {
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
-  robot.fail_through_from = 0;
-  gripper.fail_open_from = 1;  // the start's open works
-
-  const CellRunResult result = Run();
-  ASSERT_TRUE(result.fault);
-  EXPECT_FALSE(result.gripper_opened);
-  EXPECT_NE(result.message.find("gripper could not be opened (Robotiq 2F-85: no Modbus reply"),
-            std::string::npos)
-      << result.message;
-  EXPECT_EQ(Records("safe_stop").at(0)["gripper_opened"], false);
 }
 
 TEST_F(CellControllerTest, UnusablePlanIsAServerError) {

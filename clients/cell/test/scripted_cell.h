@@ -3,6 +3,7 @@
 // Scripted devices and a scripted planner for the cell controller's state-machine tests: hardware
 // cannot run in CI, so each fake answers from a queue the test fills and records what it was asked.
 
+#include <algorithm>
 #include <deque>
 #include <functional>
 #include <optional>
@@ -34,12 +35,15 @@ class ScriptedScanner final : public devices::Scanner {
  public:
   /// Failures by call index (0-based); other calls return a few points.
   std::vector<std::optional<Failure>> failures;
+  /// Calls (0-based) that return no point.
+  std::vector<int> empty_at;
   int calls = 0;
 
   devices::Capture Scan(devices::Timeout) override {
     const int i = calls++;
     if (i < static_cast<int>(failures.size()) && failures[i]) failures[i]->Throw();
     devices::Capture c;
+    if (std::find(empty_at.begin(), empty_at.end(), i) != empty_at.end()) return c;
     c.points_Sensor = {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.01f, 0.f, 1.f)};
     return c;
   }
@@ -64,9 +68,12 @@ class ScriptedRobot final : public devices::Robot {
   std::optional<int> fail_through_from;
   bool fail_always = false;
   Failure failure{false, "YRC1000 alarm 4107: out of range (joint T)"};
+  /// An alarm on the first MoveTo whose target this returns true for (and every motion after it).
+  std::function<bool(const Eigen::Isometry3d&)> alarm_on_move_to;
   int throughs = 0;
 
   void MoveTo(const Eigen::Isometry3d& X_BinTcpTarget, double speed, devices::Timeout) override {
+    if (alarm_on_move_to && alarm_on_move_to(X_BinTcpTarget)) fail_always = true;
     if (fail_always) failure.Throw();
     moves.push_back({false, X_BinTcpTarget, {}, speed});
     X_BinTcp = X_BinTcpTarget;
@@ -103,21 +110,30 @@ class ScriptedGripper final : public devices::Gripper {
   /// Open fails with this from the n-th call on (0-based).
   std::optional<int> fail_open_from;
   Failure open_failure{true, "Robotiq 2F-85: no Modbus reply within 10000 ms"};
-  int activations = 0, opens = 0, closes = 0, moves = 0;
+  int activations = 0, opens = 0, closes = 0, moves = 0, statuses = 0;
   bool open = false;
+  /// An object is held: the last Close stopped on one and no Open since.
+  bool holding = false;
+  /// From the n-th Status call on (0-based), the object is gone (a slip).
+  std::optional<int> drop_at_status;
+  /// Where the TCP was at every successful Open (set by the test to the robot's pose).
+  const Eigen::Isometry3d* tcp = nullptr;
+  std::vector<Eigen::Vector3d> opened_at;
   std::vector<double> openings;
 
   void Activate(devices::Timeout) override { ++activations; }
   devices::GripperStatus MoveTo(double opening, double, double, devices::Timeout) override {
     ++moves;
     openings.push_back(opening);
-    return Status({});
+    return Current();
   }
   devices::GripperStatus Open(devices::Timeout) override {
     const int i = opens++;
     if (fail_open_from && i >= *fail_open_from) open_failure.Throw();
     open = true;
-    devices::GripperStatus s = Status({});
+    holding = false;
+    if (tcp) opened_at.push_back(tcp->translation());
+    devices::GripperStatus s = Current();
     s.opening = 0.085;
     return s;
   }
@@ -132,32 +148,53 @@ class ScriptedGripper final : public devices::Gripper {
       s = close_results.front();
       close_results.pop_front();
     }
+    holding = s.object == devices::GripperObject::kStoppedClosing && s.fault == 0;
     return s;
   }
   devices::GripperStatus Status(devices::Timeout) override {
+    const int i = statuses++;
+    if (drop_at_status && i >= *drop_at_status) holding = false;
+    return Current();
+  }
+  devices::GripperStatus Current() const {
     devices::GripperStatus s;
     s.activated = activations > 0;
-    s.object = devices::GripperObject::kAtPosition;
+    s.object = holding ? devices::GripperObject::kStoppedClosing : devices::GripperObject::kAtPosition;
+    s.opening = holding ? 0.025 : 0.0;
     return s;
   }
 };
 
 class ScriptedForceTorque final : public devices::ForceTorqueSensor {
  public:
-  /// Readings in order; when empty, zero.
+  /// Readings in order; when they run out, the last one again.
   std::deque<devices::WrenchReading> readings;
+  devices::WrenchReading last;
+  bool queued = false;
+  /// Without scripted readings: held_force (N along z_Tcp, down) while *holding, else zero.
+  const bool* holding = nullptr;
+  double held_force = 0.54;
   /// Reads fail from the n-th call on (0-based).
   std::optional<int> fail_read_from;
   Failure failure{true, "ATI Net F/T: no RDT packet within 2000 ms"};
+  /// Reads (0-based) that time out once.
+  std::vector<int> fail_once_at;
   int biases = 0, reads = 0;
 
   devices::WrenchReading Read(devices::Timeout) override {
     const int i = reads++;
     if (fail_read_from && i >= *fail_read_from) failure.Throw();
-    if (readings.empty()) return {};
-    devices::WrenchReading r = readings.front();
+    if (std::find(fail_once_at.begin(), fail_once_at.end(), i) != fail_once_at.end()) failure.Throw();
+    if (readings.empty()) {
+      if (queued) return last;   // the load has not changed since the last scripted reading
+      devices::WrenchReading r;  // nothing scripted: the load follows what the gripper holds
+      if (holding && *holding) r.force.z() = held_force;
+      return r;
+    }
+    queued = true;
+    last = readings.front();
     readings.pop_front();
-    return r;
+    return last;
   }
   void Bias(devices::Timeout) override { ++biases; }
 };
@@ -171,6 +208,8 @@ class ScriptedPlanner final : public PlannerClient {
   };
   std::deque<PlanAnswer> plan_answers;
   std::deque<v1::AnalyzeWrenchResponse> wrench_answers;
+  /// Thrown by every AnalyzeWrench when set (the planner gone).
+  std::optional<PlannerError> wrench_error;
   std::vector<v1::PlanPickRequest> plan_requests;
   std::vector<v1::AnalyzeWrenchRequest> wrench_requests;
 
@@ -189,6 +228,7 @@ class ScriptedPlanner final : public PlannerClient {
   v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
                                           std::chrono::milliseconds) override {
     wrench_requests.push_back(request);
+    if (wrench_error) throw *wrench_error;
     if (wrench_answers.empty())
       throw PlannerError("AnalyzeWrench", grpc::StatusCode::INTERNAL, "unscripted", 1);
     v1::AnalyzeWrenchResponse a = wrench_answers.front();

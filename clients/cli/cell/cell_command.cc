@@ -6,7 +6,10 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_config.h"
@@ -14,6 +17,9 @@
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
 #include "clients/cli/cell/cell_tables.h"
+#include "clients/cli/cell/fault_campaign.h"
+#include "clients/cli/cell/fault_injector.h"
+#include "clients/cli/cell/planner_outage.h"
 #include "clients/cli/cell/sim_round.h"
 #include "clients/cli/remote/server_process.h"
 #include "core/common/cell_config.h"
@@ -41,7 +47,9 @@ struct CellOptions {
   std::uint32_t max_attempts_per_tube = 0;
   std::string controller_path;  ///< empty = the controller's defaults
   bool print_controller_config = false;
-  std::string cell_path;  ///< empty = the thesis cell for --material
+  std::string cell_path;    ///< empty = the thesis cell for --material
+  double fault_rate = 0.0;  ///< --inject-faults
+  std::uint64_t fault_seed = 1;
   // Options given on the command line (they override --controller).
   bool profile_given = false;
   bool resolution_given = false;
@@ -96,18 +104,27 @@ void Run(const CellOptions& o) {
   if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
   const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
 
-  std::unique_ptr<ServerProcess> server;
+  if (!(o.fault_rate >= 0.0 && o.fault_rate <= 1.0))
+    throw InvalidArgument(
+        fmt::format("--inject-faults: a probability per state in [0, 1], got {}", o.fault_rate));
+  const bool injecting = o.fault_rate > 0.0;
+
+  std::unique_ptr<RestartableServer> server;
   std::string address = o.server;
   if (o.server == "auto") {
-    server =
-        ServerProcess::Start(SiblingExecutable("tubepick-server"),
-                             {"--address", "127.0.0.1:0", "--metrics-address", "", "--log-level", "info"},
-                             std::chrono::seconds(60));
+    server = std::make_unique<RestartableServer>(
+        SiblingExecutable("tubepick-server"),
+        std::vector<std::string>{"--metrics-address", "", "--log-level", "info"});
     address = server->address();
     fmt::print("planner: started tubepick-server (pid {}) on {}\n", server->pid(), address);
   } else {
     fmt::print("planner: {}\n", address);
+    if (injecting)
+      fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
   }
+  std::function<void(double)> planner_outage;
+  if (server) planner_outage = [&server](double seconds) { server->Outage(seconds); };
+  FaultCampaign campaign;
   cell::GrpcPlannerClient planner(address);
 
   cell::MemoryRecordSink memory;
@@ -123,16 +140,25 @@ void Run(const CellOptions& o) {
     devices::sim::SimCellParams sim_params =
         devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
     if (custom_cell) sim_params.cell = cell_config;
-    const SimRoundResult r = RunSimRound(planner, sim_params, params, round, &sink);
+    if (server) server->AwaitBack();
+    const auto round_start = std::chrono::steady_clock::now();
+    devices::sim::SimCell sim(sim_params);
+    std::optional<FaultInjector> injector;
+    std::function<void(cell::CellState)> observer;
+    if (injecting) {
+      injector.emplace(o.fault_rate, o.fault_seed * 1000 + round, sim, planner_outage);
+      observer = [&injector](cell::CellState state) { injector->OnState(state); };
+    }
+    const SimRoundResult r = RunSimRound(planner, sim, params, round, &sink, observer);
+    campaign.Add(r, injector ? &*injector : nullptr);
     const cell::CellRunResult& result = r.run;
     const std::uint32_t left = r.tubes_in_bin;
-    const double wall = r.wall_s;
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     fmt::print(
-        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} attempts, {} scans, {:.0f} s "
-        "simulated, "
-        "{:.0f} s wall\n",
-        round, o.seed + round, result.message, result.picks, left, result.attempts, result.scans,
-        r.simulated_s, wall);
+        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released outside, "
+        "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall\n",
+        round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
+        result.attempts, result.scans, r.simulated_s, wall);
     std::fflush(stdout);
     rounds_json.push_back({{"round", round},
                            {"seed", o.seed + round},
@@ -140,13 +166,16 @@ void Run(const CellOptions& o) {
                            {"message", result.message},
                            {"picks", result.picks},
                            {"tubes_left", left},
+                           {"lost_in_transit", result.lost},
+                           {"released_outside", r.tubes_elsewhere},
+                           {"still_held", r.tubes_held},
                            {"attempts", result.attempts},
                            {"scans", result.scans},
                            {"simulated_s", r.simulated_s},
                            {"wall_s", wall}});
     if (result.reason == cell::CellStopReason::kFault) {
       any_fault = true;
-      if (result.fault && result.fault->kind() == cell::FaultKind::kServerUnavailable) {
+      if (!injecting && result.fault && result.fault->kind() == cell::FaultKind::kServerUnavailable) {
         fmt::print("planner unavailable: the remaining rounds are skipped\n");
         break;
       }
@@ -158,6 +187,7 @@ void Run(const CellOptions& o) {
                          stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
                                             stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
   if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  if (injecting) fmt::print("{}\n{}\n", campaign.KindsLine(), campaign.SummaryLine());
   if (!o.json_path.empty()) {
     std::ofstream out(o.json_path);
     if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", o.json_path));
@@ -165,6 +195,7 @@ void Run(const CellOptions& o) {
                 {"tubes", o.tubes},
                 {"seed", o.seed},
                 {"rounds", rounds_json},
+                {"faults", campaign.Json(o.fault_rate, o.fault_seed)},
                 {"statistics", cell::StatisticsJson(stats)}}
                .dump(2)
         << '\n';
@@ -174,7 +205,8 @@ void Run(const CellOptions& o) {
     const int status = server->Stop(std::chrono::seconds(15));
     spdlog::info("tubepick-server exited with status {}", status);
   }
-  if (any_fault) throw CLI::RuntimeError(3);
+  // A campaign expects safe stops; what it must never see is a tube released outside.
+  if (injecting ? campaign.released_outside > 0 : any_fault) throw CLI::RuntimeError(3);
 }
 
 }  // namespace
@@ -221,6 +253,14 @@ void AddCellCommand(CLI::App& app) {
                   "Cell YAML (bin, sensor, place, tube) for the simulated cell and the planner requests "
                   "(default: the thesis cell for --material)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--inject-faults", o->fault_rate,
+                  "Fault campaign: on every state the controller enters, this probability of a device or "
+                  "planner fault fitting the state (robot alarm, gripper fault, slip, F/T timeout or spike, "
+                  "scanner timeout or empty scan, planner outage); exit 3 only if a tube ends outside the "
+                  "bin and the place zone")
+      ->capture_default_str();
+  cmd->add_option("--fault-seed", o->fault_seed, "Seed of the injected faults (round r: seed·1000 + r)")
+      ->capture_default_str();
   cmd->callback([o, profile, resolution, plan_deadline] {
     o->profile_given = profile->count() > 0;
     o->resolution_given = resolution->count() > 0;

@@ -3,6 +3,11 @@
 #include <chrono>
 
 namespace tubepick::cli {
+namespace {
+
+constexpr double kRestAfterRound = 2.0;  // simulated seconds
+
+}  // namespace
 
 SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::SimCellParams& sim_params,
                            const cell::CellControllerParams& params, std::uint32_t round,
@@ -16,7 +21,7 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::Sim
 
 SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& sim,
                            const cell::CellControllerParams& params, std::uint32_t round,
-                           cell::RecordSink* sink) {
+                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer) {
   const auto wall_start = std::chrono::steady_clock::now();
   cell::CellController controller({&sim.scanner(), &sim.robot(), &sim.gripper(), &sim.ft_sensor()}, planner,
                                   sim.cell(), params, sink);
@@ -24,13 +29,19 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& 
   controller.set_annotator([&sim] {
     return nlohmann::json{{"tubes_in_bin", sim.TubesInBin()},
                           {"tubes_outside_bin", sim.TubesOutsideBin()},
+                          {"tubes_elsewhere", sim.TubesElsewhere()},
                           {"held", sim.HeldTubes().size()},
                           {"sim_seconds", sim.SimulatedSeconds()}};
   });
+  if (observer) controller.set_state_observer(std::move(observer));
   SimRoundResult result;
   result.run = controller.Run(round);
+  sim.Advance(kRestAfterRound);  // what fell comes to rest before it is counted
   result.tubes_in_bin = sim.TubesInBin();
   result.tubes_outside_bin = sim.TubesOutsideBin();
+  result.tubes_in_place_zone = sim.TubesInPlaceZone();
+  result.tubes_elsewhere = sim.TubesElsewhere();
+  result.tubes_held = static_cast<std::uint32_t>(sim.HeldTubes().size());
   result.simulated_s = sim.SimulatedSeconds();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
@@ -12,9 +13,14 @@ namespace tubepick::cli {
 /// One closed-loop round in the simulated cell.
 struct SimRoundResult {
   cell::CellRunResult run;
-  /// Ground truth at the end: tubes still in the bin and outside it (placed or lost).
+  /// Ground truth at the end, after 2 s of simulated rest: tubes still in the bin, outside it
+  /// (placed or lost), in the place zone, and anywhere else (neither bin, zone nor gripper).
   std::uint32_t tubes_in_bin = 0;
   std::uint32_t tubes_outside_bin = 0;
+  std::uint32_t tubes_in_place_zone = 0;
+  std::uint32_t tubes_elsewhere = 0;
+  /// Tubes the gripper still holds (a safe stop that could not release).
+  std::uint32_t tubes_held = 0;
   /// Simulated seconds of the round and the wall time it took (cell construction included).
   double simulated_s = 0.0;
   double wall_s = 0.0;
@@ -30,9 +36,9 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::Sim
                            cell::RecordSink* sink);
 
 /// The same on a cell built by the caller (e.g. with explicit tubes: SimCell(params, tubes_Bin));
-/// wall_s then covers only the run.
+/// wall_s then covers only the run. `observer` (if set) sees every state the controller enters.
 SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& sim,
                            const cell::CellControllerParams& params, std::uint32_t round,
-                           cell::RecordSink* sink);
+                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer = {});
 
 }  // namespace tubepick::cli

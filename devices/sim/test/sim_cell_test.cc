@@ -124,7 +124,88 @@ TEST(SimCell, IsolatedTubeLiftReadsItsWeightAndPlacesOutside) {
   cell.Advance(1.0);
   EXPECT_EQ(cell.TubesOutsideBin(), 1u);
   EXPECT_EQ(cell.TubesInBin(), 0u);
+  EXPECT_EQ(cell.TubesInPlaceZone(), 1u);
+  EXPECT_EQ(cell.TubesElsewhere(), 0u);
   EXPECT_LT(cell.TubeCentresOfMass()[0].z(), 0.03);  // on the ground
+}
+
+/// An isolated tube grasped in the middle and lifted 0.3 m.
+void GraspAndLift(SimCell& cell) {
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  ASSERT_EQ(Grasp(cell, GraspAt(cell.TubesBin()[0], 0.25)).object, GripperObject::kStoppedClosing);
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 0.3)}, 0.25, kLong);
+  ASSERT_EQ(cell.HeldTubes().size(), 1u);
+}
+
+TEST(SimCell, ArmedSlipDropsTheHeldTubeMidMotionAndTheGripperSaysSo) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  GraspAndLift(cell);
+  const double y_start = cell.X_BinTcp().translation().y();
+  cell.ArmSlip(0.5);  // half a second into the next motion
+  Eigen::Isometry3d X_across = cell.X_BinTcp();
+  X_across.translation().y() = 0.8;
+  cell.robot().MoveTo(X_across, 0.25, kLong);
+  EXPECT_TRUE(cell.HeldTubes().empty());
+  EXPECT_EQ(cell.fault_events().slips, 1u);
+  EXPECT_EQ(cell.gripper().Status(kLong).object, GripperObject::kAtPosition);
+  cell.Advance(2.0);
+  // It fell soon after the start, over the bin (0.5 s at 0.5 m/s² moves the TCP 6 cm), and slid a
+  // little further with the motion's momentum.
+  EXPECT_EQ(cell.TubesInBin(), 1u);
+  EXPECT_GT(cell.TubeCentresOfMass()[0].y(), y_start);
+  EXPECT_LT(cell.TubeCentresOfMass()[0].y(), 0.5 * params.cell.bin.inner_size.y());
+  EXPECT_EQ(cell.TubesElsewhere(), 0u);
+}
+
+TEST(SimCell, TubeDroppedBesideThePlaceZoneCountsAsElsewhere) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  GraspAndLift(cell);
+  Eigen::Isometry3d X_beside = cell.X_BinTcp();
+  X_beside.translation() = Eigen::Vector3d(0.65, 0.8, 0.3);  // past the zone's +x edge at 0.4 m
+  cell.robot().MoveTo(X_beside, 0.25, kLong);
+  cell.gripper().Open(kLong);
+  cell.Advance(2.0);
+  EXPECT_EQ(cell.TubesInBin(), 0u);
+  EXPECT_EQ(cell.TubesInPlaceZone(), 0u);
+  EXPECT_EQ(cell.TubesElsewhere(), 1u);
+}
+
+TEST(SimCell, ArmedRobotAlarmStopsTheMotionAndTheServo) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  cell.robot().ServoOn(kLong);
+  const Eigen::Isometry3d X_start = cell.X_BinTcp();
+  cell.ArmRobotAlarm(0.4);
+  EXPECT_THAT([&] { cell.robot().MoveTo(Raised(X_start, -0.3), 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("alarm 4100 (injected")));
+  const double moved = (cell.X_BinTcp().translation() - X_start.translation()).norm();
+  EXPECT_GT(moved, 0.01);
+  EXPECT_LT(moved, 0.1);  // 0.4 s of a 0.3 m move: stopped partway
+  EXPECT_EQ(cell.fault_events().robot_alarms, 1u);
+  EXPECT_THAT([&] { cell.robot().MoveTo(X_start, 0.25, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("servo off")));
+  EXPECT_TRUE(cell.robot().CurrentPose(kLong).isApprox(cell.X_BinTcp()));  // still reports where it is
+}
+
+TEST(SimCell, OneShotFaultsSpikesAndEmptyScans) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  cell.InjectFaultOnce(SimDevice::kForceTorque, SimFault::kTimeout);
+  EXPECT_THROW(cell.ft_sensor().Read(kLong), DeviceTimeout);
+  const WrenchReading quiet = cell.ft_sensor().Read(kLong);  // the next read works
+  cell.InjectFtSpike();
+  EXPECT_NEAR(cell.ft_sensor().Read(kLong).force.z() - quiet.force.z(), 25.0, 0.2);
+  EXPECT_NEAR(cell.ft_sensor().Read(kLong).force.z(), quiet.force.z(), 0.2);
+  cell.InjectEmptyScan();
+  EXPECT_TRUE(cell.scanner().Scan(kLong).points_Sensor.empty());
+  EXPECT_FALSE(cell.scanner().Scan(kLong).points_Sensor.empty());
+  const SimFaultEvents& events = cell.fault_events();
+  EXPECT_EQ(events.device_failures, 1u);
+  EXPECT_EQ(events.ft_spikes, 1u);
+  EXPECT_EQ(events.empty_scans, 1u);
 }
 
 TEST(SimCell, CloseOnNothingReachesFullyClosed) {

@@ -1,0 +1,123 @@
+// The safe stop: what the controller does after a fault, knowing what the gripper holds. Nothing:
+// stop where the arm is. A tube (or not sure): up, over the bin's middle, down into it and open; if
+// the arm cannot move or the gripper cannot open, keep the gripper closed and say where the tube is.
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+#include "clients/cell/attempt_record.h"
+#include "clients/cell/cell_controller.h"
+#include "clients/cell/cell_controller_internal.h"
+
+namespace tubepick::cell {
+namespace {
+
+std::string FormatPosition(const Eigen::Vector3d& p) {
+  return fmt::format("({:.3f}, {:.3f}, {:.3f}) m", p.x(), p.y(), p.z());
+}
+
+}  // namespace
+
+using detail::kSameHeight;
+using detail::WithHeight;
+
+/// Nothing held: stop where the arm is. Holding (or not sure): back over the bin, down into it and
+/// open; when the arm or the gripper cannot do that, keep the gripper closed and say where the tube
+/// is held. Never throws, never opens the gripper outside the bin.
+void CellController::SafeStop(const CellFault& fault, CellRunResult& result) {
+  Enter(CellState::kSafeStop);
+  spdlog::error("cell: {}", fault.what());
+  SafeStopOutcome outcome;
+  outcome.held = held_;
+  std::string note;
+  if (held_ == Held::kNothing) {
+    outcome.action = "stopped";
+    note = "nothing held: stopped where it is";
+    try {
+      outcome.p_Bin_tcp = devices_.robot->CurrentPose(params_.robot_timeout).translation();
+      note += fmt::format(" (X_BinTcp at {})", FormatPosition(*outcome.p_Bin_tcp));
+    } catch (const std::exception& e) {
+      note += fmt::format(" (the robot did not report its pose: {})", e.what());
+    }
+  } else {
+    note = ReturnHeldTubeToBin(outcome);
+  }
+  result.reason = CellStopReason::kFault;
+  result.fault = fault;
+  result.safe_stop = outcome;
+  result.message = fmt::format("SAFE STOP: {} {} during {}: {}; {}", fault.device(), ToString(fault.kind()),
+                               fault.state(), fault.error(), note);
+  spdlog::error("cell: {}", result.message);
+  if (sink_) sink_->Write(SafeStopRecord(round_, fault, result));
+}
+
+Eigen::Isometry3d CellController::SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const {
+  // Turn about the vertical so that x_Tcp (along the grasped tube) lies along the bin's longer side,
+  // by the smaller of the two turns that do.
+  const Eigen::Vector3d x_Tcp = X_BinTcpNow.linear().col(0);
+  const Eigen::Vector3d size = cell_.bin.inner_size;
+  const double target = size.x() >= size.y() ? 0.0 : M_PI / 2;
+  double turn = target - std::atan2(x_Tcp.y(), x_Tcp.x());
+  turn = std::remainder(turn, M_PI);  // a tube is symmetric: ±x_Tcp are the same
+  Eigen::Isometry3d X_BinTcpRelease = X_BinTcpNow;
+  X_BinTcpRelease.linear() = Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()) * X_BinTcpNow.linear();
+  X_BinTcpRelease.translation() = Eigen::Vector3d(0.0, 0.0, params_.safe_release_height);
+  return X_BinTcpRelease;
+}
+
+std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
+  const std::string what = held_ == Held::kTube ? "a tube" : "possibly a tube";
+  outcome.action = "kept_closed";
+  Eigen::Isometry3d X_BinTcp;
+  try {
+    X_BinTcp = devices_.robot->CurrentPose(params_.robot_timeout);
+  } catch (const std::exception& e) {
+    return fmt::format("HOLDING {} at an unknown pose: the robot does not answer ({}); gripper kept closed",
+                       what, e.what());
+  }
+  outcome.p_Bin_tcp = X_BinTcp.translation();
+  const double z_transit = TransitHeight(params_, cell_);
+  const Eigen::Isometry3d X_BinTcpRelease = SafeReleasePose(X_BinTcp);
+  try {
+    if (X_BinTcp.translation().z() < z_transit - kSameHeight)
+      devices_.robot->MoveTo(WithHeight(X_BinTcp, z_transit), params_.transit_speed, params_.robot_timeout);
+    devices_.robot->MoveTo(WithHeight(X_BinTcpRelease, z_transit), params_.transit_speed,
+                           params_.robot_timeout);
+    devices_.robot->MoveTo(X_BinTcpRelease, params_.approach_speed, params_.robot_timeout);
+  } catch (const std::exception& e) {
+    try {
+      outcome.p_Bin_tcp = devices_.robot->CurrentPose(params_.robot_timeout).translation();
+    } catch (const std::exception&) {
+    }
+    return fmt::format("HOLDING {} at X_BinTcp {}: the robot cannot move ({}); gripper kept closed", what,
+                       FormatPosition(*outcome.p_Bin_tcp), e.what());
+  }
+  outcome.p_Bin_tcp = X_BinTcpRelease.translation();
+  try {
+    const devices::GripperStatus status = devices_.gripper->Open(params_.gripper_timeout);
+    if (status.fault != 0)
+      return fmt::format(
+          "HOLDING {} over the bin at X_BinTcp {}: the gripper cannot open (fault 0x{:02X}: {})", what,
+          FormatPosition(*outcome.p_Bin_tcp), status.fault, status.fault_text);
+  } catch (const std::exception& e) {
+    return fmt::format("HOLDING {} over the bin at X_BinTcp {}: the gripper cannot open ({})", what,
+                       FormatPosition(*outcome.p_Bin_tcp), e.what());
+  }
+  held_ = Held::kNothing;
+  outcome.action = "released_in_bin";
+  std::string note =
+      fmt::format("{} released into the bin at X_BinTcp {}", what, FormatPosition(*outcome.p_Bin_tcp));
+  try {
+    devices_.robot->MoveTo(WithHeight(X_BinTcpRelease, z_transit), params_.transit_speed,
+                           params_.robot_timeout);
+    outcome.p_Bin_tcp = WithHeight(X_BinTcpRelease, z_transit).translation();
+    note += ", robot moved up out of the bin";
+  } catch (const std::exception& e) {
+    note += fmt::format(", robot could not move up ({})", e.what());
+  }
+  return note;
+}
+
+}  // namespace tubepick::cell

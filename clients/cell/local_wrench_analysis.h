@@ -1,0 +1,16 @@
+#pragma once
+
+#include <string>
+
+#include "tubepick/v1/wrench.pb.h"
+
+namespace tubepick::cell {
+
+/// AnalyzeWrench run in the controller's process, for when the planner cannot be reached while a
+/// tube is held: the server's analysis (wire/wrench_analysis.h) with the wrench parameters of
+/// `profile` ("" = "fast", the server's default profile) and the request's variant.
+/// @throws InvalidArgument for a request the server would reject (same messages).
+v1::AnalyzeWrenchResponse LocalAnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
+                                             const std::string& profile);
+
+}  // namespace tubepick::cell

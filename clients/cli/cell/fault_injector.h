@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <random>
+#include <string>
+
+#include "clients/cell/cell_controller.h"
+#include "devices/sim/sim_cell.h"
+
+namespace tubepick::cli {
+
+/// Makes the simulated cell's devices (and the planner, through `planner_outage`) fail at random
+/// moments of the controller's state machine: on every state the controller enters, with
+/// probability `rate`, one fault that fits the state, drawn uniformly:
+///   scan: scanner timeout, empty scan · plan: planner outage · approach, home, release,
+///   return_to_bin, nudge: robot alarm · grasp: robot alarm, gripper fault · reference: F/T timeout,
+///   F/T spike, F/T lost · lift: robot alarm, gripper fault, slip · analyze: F/T timeout, F/T spike,
+///   F/T lost, planner outage, slip · resolve: robot alarm, F/T spike, slip · place: robot alarm,
+///   gripper fault, F/T timeout, F/T lost, slip.
+/// Robot alarms and slips happen after a random 0-2 s of further motion (a slip falls in the Bullet
+/// world wherever the gripper is then); a slip is only drawn while a tube is held. Robot alarms and
+/// gripper faults stay until the round ends, and so does "F/T lost" (every reading times out: an
+/// unplugged cable); timeouts, spikes and empty scans hit one call. A planner outage kills the
+/// server for 0.5-2 s (a restart the client's retries ride out) or 4-8 s (they do not). Same
+/// rate, seed and cell ⇒ same faults.
+class FaultInjector {
+ public:
+  /// `planner_outage(seconds)` makes the planner unreachable for that long (empty: no planner faults).
+  FaultInjector(double rate, std::uint64_t seed, devices::sim::SimCell& sim,
+                std::function<void(double)> planner_outage);
+
+  /// The controller's state observer.
+  void OnState(cell::CellState state);
+
+  /// Faults that took effect: armed ones, except robot alarms and slips that never came due.
+  std::uint32_t injected() const;
+  /// The same by kind ("robot_alarm", "slip", "gripper_fault", ...).
+  std::map<std::string, std::uint32_t> by_kind() const;
+
+ private:
+  void Inject(const std::string& kind);
+
+  double rate_;
+  std::mt19937_64 rng_;
+  devices::sim::SimCell& sim_;
+  std::function<void(double)> planner_outage_;
+  std::map<std::string, std::uint32_t> armed_;
+};
+
+}  // namespace tubepick::cli
