@@ -142,10 +142,7 @@ void SimCellState::TickRobotAlarm(double dt) {
 
 void SimCellState::Advance(double seconds) {
   const int steps = static_cast<int>(std::ceil(seconds / params.physics.time_step - 1e-9));
-  for (int i = 0; i < steps; ++i) {
-    world->ControlStep();
-    TickSlip(params.physics.time_step);
-  }
+  for (int i = 0; i < steps; ++i) world->ControlStep();
 }
 
 Wrench SimCellState::RawFtReading() {

@@ -290,9 +290,9 @@ class SimCell {
   /// After `seconds` more of simulated robot motion the robot stops with an alarm (servo off,
   /// DeviceFault), wherever it is; it stays off (the cell needs an operator).
   void ArmRobotAlarm(double seconds);
-  /// After `seconds` more of simulated time (motion, readings, scans) whatever the gripper holds
-  /// slips out and falls in the world; the gripper then reports no object. Opening the gripper
-  /// first disarms it.
+  /// After `seconds` more of robot motion whatever the gripper holds slips out and falls in the
+  /// world (a grip gives way while the tube is moved, not while it hangs still); the gripper then
+  /// reports no object. Opening the gripper first disarms it.
   void ArmSlip(double seconds);
   /// The next F/T reading carries a 25 N spike along z (a hit cable, an EMI burst).
   void InjectFtSpike();

@@ -48,7 +48,7 @@ struct SimCellState {
 
   /// Throws the injected fault of `device` (`who` prefixes the message), if any.
   void ThrowIfInjected(SimDevice device, const std::string& who) const;
-  /// Advances the armed slip by `dt` simulated seconds; when it is due, whatever the gripper holds
+  /// Advances the armed slip by `dt` seconds of robot motion; when it is due, whatever the gripper holds
   /// falls (the fingers stay, the gripper reports no object).
   void TickSlip(double dt);
   /// Advances the armed robot alarm by `dt`; when due: servo off and DeviceFault.
