@@ -57,8 +57,10 @@ TEST(CellCliTest, UnreachableServerEndsInASafeStopAndExitStatus3) {
 TEST(CellCliTest, FaultCampaignNeverReleasesATubeOutsideTheBinOrThePlaceZone) {
   const auto dir = testing::TempDir("cell-faults");
   const auto json_path = dir / "campaign.json";
+  // Seed 2 at this rate brings (deterministically: faults follow the controller's steps) a slip in
+  // transit, safe stops holding a tube and a planner outage while one is held.
   const testing::CliRun run = RunCli(
-      "cell --sim --rounds 4 --tubes 7 --inject-faults 0.1 --fault-seed 3 --json " + json_path.string());
+      "cell --sim --rounds 4 --tubes 7 --inject-faults 0.1 --fault-seed 2 --json " + json_path.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::smatch m;
   const std::string output = run.output;
@@ -77,6 +79,10 @@ TEST(CellCliTest, FaultCampaignNeverReleasesATubeOutsideTheBinOrThePlaceZone) {
   int by_kind = 0;
   for (const auto& [kind, count] : faults["by_kind"].items()) by_kind += count.get<int>();
   EXPECT_EQ(by_kind, faults["injected"].get<int>());
+  EXPECT_EQ(faults["by_kind"].value("slip", 0), 1);
+  EXPECT_EQ(faults["lost_in_transit"], 1);
+  EXPECT_GE(faults["safe_stops_holding"].get<int>(), 1);
+  EXPECT_GE(faults["local_analyses"].get<int>(), 1);
   int elsewhere = 0;
   for (const nlohmann::json& round : j["rounds"]) elsewhere += round["released_outside"].get<int>();
   EXPECT_EQ(elsewhere, 0);

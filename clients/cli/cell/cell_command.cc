@@ -122,8 +122,6 @@ void Run(const CellOptions& o) {
     if (injecting)
       fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
   }
-  std::function<void(double)> planner_outage;
-  if (server) planner_outage = [&server](double seconds) { server->Outage(seconds); };
   FaultCampaign campaign;
   cell::GrpcPlannerClient planner(address);
 
@@ -140,13 +138,16 @@ void Run(const CellOptions& o) {
     devices::sim::SimCellParams sim_params =
         devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
     if (custom_cell) sim_params.cell = cell_config;
-    if (server) server->AwaitBack();
+    if (server) {
+      server->AwaitBack();
+      server->StartAgain();  // an outage the last round ended in
+    }
     const auto round_start = std::chrono::steady_clock::now();
     devices::sim::SimCell sim(sim_params);
     std::optional<FaultInjector> injector;
     std::function<void(cell::CellState)> observer;
     if (injecting) {
-      injector.emplace(o.fault_rate, o.fault_seed * 1000 + round, sim, planner_outage);
+      injector.emplace(o.fault_rate, o.fault_seed * 1000 + round, sim, server.get());
       observer = [&injector](cell::CellState state) { injector->OnState(state); };
     }
     const SimRoundResult r = RunSimRound(planner, sim, params, round, &sink, observer);

@@ -21,6 +21,7 @@ std::vector<std::string> KindsFor(CellState state, bool holding, bool planner) {
       add("empty_scan");
       break;
     case CellState::kPlan:
+      if (planner) add("planner_restart");
       if (planner) add("planner_outage");
       break;
     case CellState::kApproach:
@@ -48,6 +49,7 @@ std::vector<std::string> KindsFor(CellState state, bool holding, bool planner) {
       add("ft_timeout");
       add("ft_spike");
       add("ft_lost");
+      if (planner) add("planner_restart");
       if (planner) add("planner_outage");
       if (holding) add("slip");
       break;
@@ -74,13 +76,17 @@ std::vector<std::string> KindsFor(CellState state, bool holding, bool planner) {
 }  // namespace
 
 FaultInjector::FaultInjector(double rate, std::uint64_t seed, devices::sim::SimCell& sim,
-                             std::function<void(double)> planner_outage)
-    : rate_(rate), rng_(seed), sim_(sim), planner_outage_(std::move(planner_outage)) {}
+                             RestartableServer* planner)
+    : rate_(rate), rng_(seed), sim_(sim), planner_(planner) {}
 
 void FaultInjector::OnState(CellState state) {
+  if (planner_down_) {
+    planner_->StartAgain();
+    planner_down_ = false;
+  }
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   if (unit(rng_) >= rate_) return;
-  const std::vector<std::string> kinds = KindsFor(state, !sim_.HeldTubes().empty(), bool(planner_outage_));
+  const std::vector<std::string> kinds = KindsFor(state, !sim_.HeldTubes().empty(), planner_ != nullptr);
   if (kinds.empty()) return;
   std::uniform_int_distribution<std::size_t> pick(0, kinds.size() - 1);
   const std::string& kind = kinds[pick(rng_)];
@@ -107,12 +113,12 @@ void FaultInjector::Inject(const std::string& kind) {
     sim_.InjectFtSpike();
   } else if (kind == "slip") {
     sim_.ArmSlip(delay(rng_));
+  } else if (kind == "planner_restart") {
+    std::uniform_real_distribution<double> down(0.5, 1.5);
+    planner_->Restart(down(rng_));
   } else if (kind == "planner_outage") {
-    // Half restarts the client's retries ride out (0.5-2 s), half longer outages (4-8 s).
-    std::uniform_real_distribution<double> restart(0.5, 2.0);
-    std::uniform_real_distribution<double> outage(4.0, 8.0);
-    std::bernoulli_distribution short_one(0.5);
-    planner_outage_(short_one(rng_) ? restart(rng_) : outage(rng_));
+    planner_->Kill();
+    planner_down_ = true;
   }
 }
 

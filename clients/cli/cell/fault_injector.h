@@ -1,12 +1,12 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <random>
 #include <string>
 
 #include "clients/cell/cell_controller.h"
+#include "clients/cli/cell/planner_outage.h"
 #include "devices/sim/sim_cell.h"
 
 namespace tubepick::cli {
@@ -14,22 +14,23 @@ namespace tubepick::cli {
 /// Makes the simulated cell's devices (and the planner, through `planner_outage`) fail at random
 /// moments of the controller's state machine: on every state the controller enters, with
 /// probability `rate`, one fault that fits the state, drawn uniformly:
-///   scan: scanner timeout, empty scan · plan: planner outage · approach, home, release,
-///   return_to_bin, nudge: robot alarm · grasp: robot alarm, gripper fault · reference: F/T timeout,
-///   F/T spike, F/T lost · lift: robot alarm, gripper fault, slip · analyze: F/T timeout, F/T spike,
-///   F/T lost, planner outage, slip · resolve: robot alarm, F/T spike, slip · place: robot alarm,
-///   gripper fault, F/T timeout, F/T lost, slip.
-/// Robot alarms and slips happen after a random 0-2 s of further motion (a slip falls in the Bullet
-/// world wherever the gripper is then); a slip is only drawn while a tube is held. Robot alarms and
-/// gripper faults stay until the round ends, and so does "F/T lost" (every reading times out: an
-/// unplugged cable); timeouts, spikes and empty scans hit one call. A planner outage kills the
-/// server for 0.5-2 s (a restart the client's retries ride out) or 4-8 s (they do not). Same
-/// rate, seed and cell ⇒ same faults.
+///   scan: scanner timeout, empty scan · plan: planner restart, planner outage · approach, home,
+///   release, return_to_bin, nudge: robot alarm · grasp: robot alarm, gripper fault · reference: F/T
+///   timeout, F/T spike, F/T lost · lift: robot alarm, gripper fault, slip · analyze: F/T timeout,
+///   F/T spike, F/T lost, planner restart, planner outage, slip · resolve: robot alarm, F/T spike,
+///   slip · place: robot alarm, gripper fault, F/T timeout, F/T lost, slip.
+/// Robot alarms and slips happen after a random 0-2 s of further robot motion (a slip falls in the
+/// Bullet world wherever the gripper is then); a slip is only drawn while a tube is held. Robot
+/// alarms and gripper faults stay until the round ends, and so does "F/T lost" (every reading times
+/// out: an unplugged cable); timeouts, spikes and empty scans hit one call. A planner restart kills
+/// the server and starts it again 0.5-1.5 s later (the client's ~5 s of retries ride it out); a
+/// planner outage kills it until the controller enters its next state (the call under way fails
+/// after its retries). Both are tied to the controller's steps, not to the wall clock, so the same
+/// rate, seed and cell give the same faults on a fast or a slow machine.
 class FaultInjector {
  public:
-  /// `planner_outage(seconds)` makes the planner unreachable for that long (empty: no planner faults).
-  FaultInjector(double rate, std::uint64_t seed, devices::sim::SimCell& sim,
-                std::function<void(double)> planner_outage);
+  /// `planner` takes the planner away (null: no planner faults).
+  FaultInjector(double rate, std::uint64_t seed, devices::sim::SimCell& sim, RestartableServer* planner);
 
   /// The controller's state observer.
   void OnState(cell::CellState state);
@@ -45,7 +46,9 @@ class FaultInjector {
   double rate_;
   std::mt19937_64 rng_;
   devices::sim::SimCell& sim_;
-  std::function<void(double)> planner_outage_;
+  RestartableServer* planner_;
+  /// The planner was killed by a "planner_outage" and comes back at the next state.
+  bool planner_down_ = false;
   std::map<std::string, std::uint32_t> armed_;
 };
 

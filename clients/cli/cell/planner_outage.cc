@@ -29,25 +29,32 @@ pid_t RestartableServer::pid() const {
   return server_ ? server_->pid() : -1;
 }
 
-void RestartableServer::Outage(double seconds) {
+void RestartableServer::Kill() {
   if (restart_.joinable()) restart_.join();
+  std::lock_guard lock(mutex_);
+  if (!server_) return;
   ++outages_;
-  {
-    std::lock_guard lock(mutex_);
-    server_->Stop(std::chrono::milliseconds(0));
-    server_.reset();
+  server_->Stop(std::chrono::milliseconds(0));
+  server_.reset();
+  spdlog::info("planner outage: tubepick-server killed");
+}
+
+void RestartableServer::StartAgain() {
+  std::lock_guard lock(mutex_);
+  if (server_) return;
+  try {
+    server_ = ServerProcess::Start(binary_, WithAddress(args_, address_), kStartupTimeout);
+    spdlog::info("planner outage: tubepick-server back on {}", address_);
+  } catch (const std::exception& e) {
+    spdlog::error("planner outage: tubepick-server did not come back on {}: {}", address_, e.what());
   }
-  spdlog::info("planner outage: tubepick-server killed, back in {:.1f} s", seconds);
+}
+
+void RestartableServer::Restart(double seconds) {
+  Kill();
   restart_ = std::thread([this, seconds] {
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
-    try {
-      std::unique_ptr<ServerProcess> server =
-          ServerProcess::Start(binary_, WithAddress(args_, address_), kStartupTimeout);
-      std::lock_guard lock(mutex_);
-      server_ = std::move(server);
-    } catch (const std::exception& e) {
-      spdlog::error("planner outage: tubepick-server did not come back on {}: {}", address_, e.what());
-    }
+    StartAgain();
   });
 }
 

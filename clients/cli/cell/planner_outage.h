@@ -11,8 +11,9 @@
 
 namespace tubepick::cli {
 
-/// The `--server auto` planner, which can be taken away for a while: Outage kills it and starts it
-/// again on the same address in the background, so the controller's channel reconnects by itself.
+/// The `--server auto` planner, which can be taken away for a while: Kill / StartAgain, or Restart
+/// (kill, then start again on the same address in the background); the controller's channel
+/// reconnects by itself.
 class RestartableServer {
  public:
   /// Starts `binary args...` (args must not carry --address: it is added).
@@ -23,14 +24,17 @@ class RestartableServer {
 
   const std::string& address() const { return address_; }
   pid_t pid() const;
-  /// Kills the server now and starts it again `seconds` later (a restart already under way is
-  /// waited for first). Returns at once.
-  void Outage(double seconds);
+  /// Kills the server now (a restart under way is waited for first); it stays down until StartAgain.
+  void Kill();
+  /// Starts the server again on the same address if it is down; waits until it listens.
+  void StartAgain();
+  /// Kills the server now and starts it again `seconds` later in the background. Returns at once.
+  void Restart(double seconds);
   /// Waits for a restart under way (the next round starts with the planner up).
   void AwaitBack() {
     if (restart_.joinable()) restart_.join();
   }
-  /// Outages so far.
+  /// Kills so far.
   int outages() const { return outages_; }
   /// Waits for a restart under way, then SIGTERM with `grace`; the exit status.
   int Stop(std::chrono::milliseconds grace);
