@@ -59,6 +59,9 @@ std::string RequestIdOf(const grpc::CallbackServerContext& context) {
   return NewRequestId();
 }
 
+// A cancel this close before a client's deadline is taken for that deadline (CallState::DeadlineReached).
+constexpr auto kClientDeadlineSkew = std::chrono::milliseconds(100);
+
 // The call's deadline on the steady clock; nullopt for none (gRPC reports "infinite" as max()).
 std::optional<Clock::time_point> SteadyDeadline(const grpc::CallbackServerContext& context) {
   const auto deadline = context.deadline();
@@ -100,10 +103,20 @@ struct PlannerService::CallState {
     return t;
   }
 
+  /// The deadline has passed, or the cancel came so close before the client's deadline that it is
+  /// the client's own: its RST_STREAM at the deadline can beat the server's timer, which started
+  /// when the headers arrived (seen on a loaded machine: CANCELLED 150 ms into a 300 ms call).
+  bool DeadlineReached() const {
+    if (token.deadline_passed()) return true;
+    const std::int64_t ns = cancelled_at.load();
+    return ns != 0 && deadline && !max_call_time_s &&
+           Clock::time_point(Clock::duration(ns)) + kClientDeadlineSkew >= *deadline;
+  }
+
   /// CANCELLED, or DEADLINE_EXCEEDED when the deadline has passed (gRPC also cancels a call at its
   /// deadline, so the token may say "cancelled" for an expired call).
   grpc::Status CancelledStatus(const std::string& what) const {
-    if (!token.deadline_passed()) return {grpc::StatusCode::CANCELLED, what};
+    if (!DeadlineReached()) return {grpc::StatusCode::CANCELLED, what};
     const std::string_view cancelled = "cancelled ";
     std::string message =
         what.rfind(cancelled, 0) == 0 ? "deadline exceeded " + what.substr(cancelled.size()) : what;

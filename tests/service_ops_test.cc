@@ -283,16 +283,22 @@ TEST(ServiceHealth, ServingUntilShutdownThenNotServing) {
 
   HealthWatch watch(server.channel(), "tubepick.v1.PickPlannerService");
   ASSERT_TRUE(watch.WaitForStatus(kServing));
-  auto shutdown = std::async(std::launch::async, [&] { server.server().Shutdown(std::chrono::seconds(5)); });
+  // A plan in flight keeps the server draining (gRPC may end health watches at once on shutdown,
+  // and the HTTP port closes when the drain is over).
+  auto plan = std::async(std::launch::async,
+                         [&] { return Call(server.stub(), SlowPlanRequest(), std::chrono::seconds(60)); });
+  WaitUntilBusy(server, 1);
+  const auto start = std::chrono::steady_clock::now();
+  auto shutdown = std::async(std::launch::async, [&] { server.server().Shutdown(std::chrono::seconds(20)); });
   EXPECT_TRUE(watch.WaitForStatus(kNotServing)) << "watchers must see NOT_SERVING when shutdown begins";
-  // Draining (the watch still holds a call open): the probe answers 503 so a proxy stops sending.
+  // Draining: the probe answers 503 so a proxy stops sending.
   const std::string draining = HttpExchange(server.metrics_port(), "GET /healthz HTTP/1.1\r\n\r\n");
   EXPECT_EQ(draining.rfind("HTTP/1.1 503 ", 0), 0u) << draining;
   EXPECT_NE(draining.find("NOT_SERVING"), std::string::npos) << draining;
-  watch.CancelAndWait();  // the last open call; shutdown completes without waiting out the grace
-  const auto start = std::chrono::steady_clock::now();
-  shutdown.get();
-  EXPECT_LT(Ms(std::chrono::steady_clock::now() - start).count(), 4000.0);
+  watch.CancelAndWait();
+  EXPECT_TRUE(plan.get().ok());  // the call in flight was let finish
+  shutdown.get();                // and then the drain ended, without waiting out the 20 s grace
+  EXPECT_LT(Ms(std::chrono::steady_clock::now() - start).count(), 15000.0);
   EXPECT_EQ(CheckHealth(server.channel(), "").status.error_code(), grpc::StatusCode::UNAVAILABLE);
 }
 
