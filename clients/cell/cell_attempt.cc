@@ -261,12 +261,8 @@ void CellController::CheckStillHolding(const char* where, Attempt& attempt) {
 
 void CellController::CheckLoadBeforePlace(const devices::WrenchReading& reference, Attempt& attempt) {
   const devices::WrenchReading above = ReadWrench();
-  v1::AnalyzeWrenchRequest request;
-  *request.mutable_reference() = ToProto(Wrench{reference.force, reference.torque});
-  *request.mutable_current() = ToProto(Wrench{above.force, above.torque});
-  request.set_tube_mass(cell_.tube.mass);
-  *request.mutable_tcp_pose() = ToProto(CurrentPose());
-  const v1::AnalyzeWrenchResponse check = LocalAnalyzeWrench(request, params_.profile);
+  const v1::AnalyzeWrenchResponse check =
+      LocalAnalyzeWrench(WrenchRequest(reference, above, CurrentPose()), params_.profile);
   attempt.record["wrench"]["before_place"] = WrenchJson(above);
   if (check.outcome() != v1::HELD_OUTCOME_NONE) return;
   throw TubeLost("place_transit", "wrench",

@@ -275,10 +275,16 @@ class CellController {
   devices::GripperStatus CheckGripper(const devices::GripperStatus& status);
   void OpenGripper();
   devices::GripperStatus CloseGripper();
-  /// Mean of params.ft_samples readings after the settle samples; a timed-out read is retried
-  /// (params.ft_read_retries), readings off the median by more than the spike limits are dropped.
+  /// Mean of params.ft_samples readings after the settle samples; readings off the median by more
+  /// than the spike limits are dropped (half of them or more dropped: a fault).
   devices::WrenchReading ReadWrench();
+  /// One reading; a timed-out one is read again (params.ft_read_retries).
   devices::WrenchReading ReadOneWrench();
+  /// AnalyzeWrench's request for these readings at X_BinTcp, with the cell's tube mass and the
+  /// controller's resolution variant.
+  v1::AnalyzeWrenchRequest WrenchRequest(const devices::WrenchReading& reference,
+                                         const devices::WrenchReading& current,
+                                         const Eigen::Isometry3d& X_BinTcp) const;
   /// AnalyzeWrench on the planner; when it cannot be reached (UNAVAILABLE after the client's
   /// retries, DEADLINE_EXCEEDED) the same analysis runs here, and the record says so.
   v1::AnalyzeWrenchResponse Analyze(const devices::WrenchReading& reference,

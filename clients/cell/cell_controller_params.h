@@ -70,7 +70,7 @@ struct CellControllerParams {
   /// Further tries of one reading that timed out (a lost RDT datagram) before it is a fault.
   std::uint32_t ft_read_retries = 2;
   /// A reading whose force (N) or torque (N·m) is farther than this from the measurement's median
-  /// is a spike and dropped; more than half dropped is a fault.
+  /// is a spike and dropped; half of the readings or more dropped is a fault.
   double ft_spike_force = 2.0;
   double ft_spike_torque = 0.2;
 

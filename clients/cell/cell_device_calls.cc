@@ -170,15 +170,22 @@ devices::WrenchReading CellController::ReadWrench() {
   return mean;
 }
 
-v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& reference,
-                                                  const devices::WrenchReading& current,
-                                                  const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) {
+v1::AnalyzeWrenchRequest CellController::WrenchRequest(const devices::WrenchReading& reference,
+                                                       const devices::WrenchReading& current,
+                                                       const Eigen::Isometry3d& X_BinTcp) const {
   v1::AnalyzeWrenchRequest request;
   *request.mutable_reference() = ToProto(Wrench{reference.force, reference.torque});
   *request.mutable_current() = ToProto(Wrench{current.force, current.torque});
   request.set_tube_mass(cell_.tube.mass);
-  *request.mutable_tcp_pose() = ToProto(X_BinTcpLift);
+  *request.mutable_tcp_pose() = ToProto(X_BinTcp);
   request.set_variant(params_.resolution_variant);
+  return request;
+}
+
+v1::AnalyzeWrenchResponse CellController::Analyze(const devices::WrenchReading& reference,
+                                                  const devices::WrenchReading& current,
+                                                  const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) {
+  const v1::AnalyzeWrenchRequest request = WrenchRequest(reference, current, X_BinTcpLift);
   const Clock::time_point start = Clock::now();
   v1::AnalyzeWrenchResponse response;
   try {

@@ -229,6 +229,18 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
   EXPECT_NE(ParseError("gripper_force: .nan\n").find("gripper_force"), std::string::npos);
 }
 
+TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
+  EXPECT_NE(
+      ParseError("safe_release_height: 0\n").find("safe_release_height: must be a positive number, got 0"),
+      std::string::npos)
+      << ParseError("safe_release_height: 0\n");
+  EXPECT_NE(ParseError("ft_spike_force: -1\n").find("ft_spike_force: must be a positive number, got -1"),
+            std::string::npos);
+  EXPECT_NE(ParseError("ft_spike_torque: .nan\n").find("ft_spike_torque"), std::string::npos);
+  EXPECT_NE(ParseError("scan_retries: -1\n").find("scan_retries"), std::string::npos);
+  EXPECT_NE(ParseError("ft_read_retries: two\n").find("ft_read_retries"), std::string::npos);
+}
+
 TEST(CellControllerConfigTest, LoadNamesTheFile) {
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() / "tubepick_cell_controller_config_test.yaml";

@@ -33,7 +33,6 @@ void RestartableServer::Kill() {
   if (restart_.joinable()) restart_.join();
   std::lock_guard lock(mutex_);
   if (!server_) return;
-  ++outages_;
   server_->Stop(std::chrono::milliseconds(0));
   server_.reset();
   spdlog::info("planner outage: tubepick-server killed");

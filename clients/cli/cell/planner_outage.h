@@ -34,8 +34,6 @@ class RestartableServer {
   void AwaitBack() {
     if (restart_.joinable()) restart_.join();
   }
-  /// Kills so far.
-  int outages() const { return outages_; }
   /// Waits for a restart under way, then SIGTERM with `grace`; the exit status.
   int Stop(std::chrono::milliseconds grace);
 
@@ -46,7 +44,6 @@ class RestartableServer {
   mutable std::mutex mutex_;
   std::unique_ptr<ServerProcess> server_;
   std::thread restart_;
-  int outages_ = 0;
 };
 
 }  // namespace tubepick::cli
