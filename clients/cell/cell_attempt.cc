@@ -285,9 +285,11 @@ void CellController::RecordLost(const TubeLost& lost, Attempt& attempt) {
   attempt.record["lost"] = where;
   spdlog::warn("cell: round {}: tube lost during {} ({}: {})", round_, lost.state, lost.detected_by,
                lost.what());
-  Enter(CellState::kRelease);
-  OpenGripper();  // the fingers closed on nothing
+  // The gripper says it holds nothing; should it be wrong, the fingers open at home (above the
+  // place frame by default), not wherever the loss was noticed.
   GoHome(&attempt);
+  Enter(CellState::kRelease);
+  OpenGripper();
 }
 
 /// Nothing held after the lift: open where the gripper is, home.

@@ -807,7 +807,7 @@ TEST_F(PlaceFaultTest, PlannerGoneDuringThePlaceChangesNothing) {
 }
 
 TEST_F(PlaceFaultTest, SlipInTransitIsRecordedAsLostAndTheRoundGoesOn) {
-  gripper.drop_at_status = 2;  // after the lift and the first transit segment it still holds
+  gripper.drop_at_status = 1;  // after the lift it still holds; after the way up it does not
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
   EXPECT_EQ(result.picks, 0u);
@@ -821,6 +821,9 @@ TEST_F(PlaceFaultTest, SlipInTransitIsRecordedAsLostAndTheRoundGoesOn) {
   EXPECT_EQ(a["lost"]["p_Bin_tcp"].size(), 3u);
   EXPECT_EQ(Records("end").at(0)["lost"], 1);
   EXPECT_EQ(SummarizeRecords(sink.records()).lost_in_transit, 1u);
+  // The fingers were opened at home, not where the loss was noticed.
+  ASSERT_EQ(gripper.opened_at.size(), 2u);
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(HomePose(params, cell).translation(), kTol));
 }
 
 TEST_F(PlaceFaultTest, NoLoadAboveThePlaceIsALostTubeEvenWhenTheGripperSaysHolding) {
