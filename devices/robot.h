@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include <string>
@@ -26,6 +27,17 @@ struct RobotLimits {
   std::string Problem(const Eigen::Isometry3d& X_BinTcp) const;
 };
 
+/// What a robot controller says about itself (devices check, logs).
+struct RobotStatus {
+  bool servo_on = false;
+  bool alarm = false;
+  bool error = false;
+  /// A motion is under way.
+  bool running = false;
+  /// The raw status as the controller gives it (e.g. "data 1 0x00000002, data 2 0x00000040").
+  std::string detail;
+};
+
 /// A robot arm moving its tool-centre point (thesis §5.3.1.1). Poses are X_BinTcp: the TCP in the
 /// bin frame (the driver owns the transform to the robot base).
 class Robot {
@@ -41,6 +53,9 @@ class Robot {
   virtual Eigen::Isometry3d CurrentPose(Timeout timeout) = 0;
   /// Servo power on. @throws DeviceTimeout, DeviceFault.
   virtual void ServoOn(Timeout timeout) = 0;
+  /// Servo, alarm and motion state, or nullopt when the driver cannot read them.
+  /// @throws DeviceTimeout, DeviceFault.
+  virtual std::optional<RobotStatus> Status(Timeout /*timeout*/) { return std::nullopt; }
   /// Reach, tilt and speed limits (from the driver's configuration; no device round trip).
   virtual RobotLimits Limits() const = 0;
 };

@@ -153,16 +153,19 @@ Eigen::Isometry3d PoseFromWords(std::span<const std::int32_t, 6> words) {
   return X;
 }
 
-std::array<std::int32_t, kMoveWords> MoveData(const Eigen::Isometry3d& X_BaseTcp, double speed) {
+std::array<std::int32_t, kMoveWords> MoveData(const Eigen::Isometry3d& X_FrameTcp, double speed,
+                                              MoveFrame frame) {
   std::array<std::int32_t, kMoveWords> words{};
-  words[0] = 1;                   // robot number
-  words[1] = 0;                   // station number
-  words[2] = kSpeedClassV;        // speed class
-  words[3] = Round(speed * 1e4);  // m/s -> 0.1 mm/s
-  words[4] = kCoordinateBase;     // coordinate
-  const auto pose = PoseToWords(X_BaseTcp);
+  words[0] = 1;                                                         // robot number
+  words[1] = 0;                                                         // station number
+  words[2] = kSpeedClassV;                                              // speed class
+  words[3] = Round(speed * 1e4);                                        // m/s -> 0.1 mm/s
+  words[4] = frame.user_frame > 0 ? kCoordinateUser : kCoordinateBase;  // coordinate
+  const auto pose = PoseToWords(X_FrameTcp);
   std::copy(pose.begin(), pose.end(), words.begin() + 5);
-  // [11], [12] reserve; [13] type; [14] expanded type; [15] tool no; [16] user coordinate no;
+  // [11], [12] reserve; [13] type; [14] expanded type: 0.
+  words[15] = frame.tool;
+  words[16] = frame.user_frame;
   // [17..19] base axes; [20..25] station axes: all 0.
   return words;
 }
@@ -172,6 +175,13 @@ std::array<std::int32_t, kMoveWords> MoveData(const Eigen::Isometry3d& X_BaseTcp
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// Within the words' rounding and a controller's positioning: 1 mm and 0.01 rad.
+bool AtTarget(const Eigen::Isometry3d& X_BinTcp, const Eigen::Isometry3d& X_BinTcpTarget) {
+  const double distance = (X_BinTcp.translation() - X_BinTcpTarget.translation()).norm();
+  const double angle = Eigen::AngleAxisd(X_BinTcp.linear().transpose() * X_BinTcpTarget.linear()).angle();
+  return distance <= 1e-3 && angle <= 1e-2;
+}
 
 std::string Hex(unsigned v, int digits) {
   char buf[16];
@@ -187,13 +197,26 @@ YaskawaHses::YaskawaHses(YaskawaHsesParams params)
 hses::Answer YaskawaHses::Transact(hses::Request request, TimePoint deadline, Timeout timeout) {
   const std::string who = "Yaskawa HSES " + params_.host + " command " + Hex(request.command, 2);
   std::uint8_t buf[512];
-  udp_.DrainStale();  // late answers of an earlier, timed-out request must not answer this one
-  request.request_id = next_request_id_++;
-  const std::vector<std::uint8_t> bytes = hses::EncodeRequest(request);
-  udp_.Send(bytes, deadline);
+  // Reads change nothing on the controller, so an unanswered one is sent again; a move is not.
+  const bool resend = request.command != static_cast<std::uint16_t>(hses::Command::kMoveCartesian) &&
+                      request.command != static_cast<std::uint16_t>(hses::Command::kHoldServo);
+  TimePoint answer_deadline{};
+  auto send = [&] {
+    udp_.DrainStale();  // late answers of an earlier, timed-out request must not answer this one
+    request.request_id = next_request_id_++;
+    udp_.Send(hses::EncodeRequest(request), deadline);
+    answer_deadline = std::min(deadline, Clock::now() + params_.request_timeout);
+  };
+  send();
   for (;;) {
-    const std::optional<std::size_t> got = udp_.Receive(buf, deadline);
-    if (!got) throw DeviceTimeout(who + ": no answer within " + std::to_string(timeout.count()) + " ms");
+    const std::optional<std::size_t> got = udp_.Receive(buf, answer_deadline);
+    if (!got && resend && Clock::now() < deadline) {
+      send();
+      continue;
+    }
+    if (!got)
+      throw DeviceTimeout(who + ": no answer within " +
+                          std::to_string(std::min(timeout, params_.request_timeout).count()) + " ms");
     const auto answer = hses::DecodeAnswer(std::span<const std::uint8_t>(buf, *got));
     if (!answer) {
       throw DeviceFault(who + ": malformed answer of " + std::to_string(*got) + " bytes");
@@ -244,6 +267,27 @@ Eigen::Isometry3d YaskawaHses::PoseUntil(TimePoint deadline, Timeout timeout) {
   return params_.X_BaseBin.inverse() * X_BaseTcp;
 }
 
+std::optional<RobotStatus> YaskawaHses::Status(Timeout timeout) {
+  hses::Request request;
+  request.command = static_cast<std::uint16_t>(hses::Command::kStatusRead);
+  request.instance = 1;
+  request.attribute = 0;
+  request.service = hses::kServiceGetAll;
+  const hses::Answer answer = Transact(std::move(request), Clock::now() + timeout, timeout);
+  const std::vector<std::int32_t> data = hses::DecodeWords(answer.data);
+  if (data.size() < 2)
+    throw DeviceFault("Yaskawa HSES: status answer of " + std::to_string(answer.data.size()) + " bytes");
+  const auto data1 = static_cast<std::uint32_t>(data[0]);
+  const auto data2 = static_cast<std::uint32_t>(data[1]);
+  RobotStatus status;
+  status.running = (data1 & hses::kStatus1Running) != 0;
+  status.servo_on = (data2 & hses::kStatus2ServoOn) != 0;
+  status.alarm = (data2 & hses::kStatus2Alarm) != 0;
+  status.error = (data2 & hses::kStatus2Error) != 0;
+  status.detail = "data 1 " + Hex(data1, 8) + ", data 2 " + Hex(data2, 8);
+  return status;
+}
+
 Eigen::Isometry3d YaskawaHses::CurrentPose(Timeout timeout) {
   return PoseUntil(Clock::now() + timeout, timeout);
 }
@@ -255,10 +299,15 @@ void YaskawaHses::MoveUntil(const Eigen::Isometry3d& X_BinTcp, double speed, Tim
   move.instance = hses::kStraightAbsolute;
   move.attribute = 1;
   move.service = hses::kServiceSetAll;
-  const auto words =
-      hses::MoveData(params_.X_BaseBin * X_BinTcp, speed > 0.0 ? speed : params_.default_speed);
+  const Eigen::Isometry3d X_FrameBin =
+      params_.user_frame > 0 ? params_.X_BaseUser.inverse() * params_.X_BaseBin : params_.X_BaseBin;
+  const auto words = hses::MoveData(X_FrameBin * X_BinTcp, speed > 0.0 ? speed : params_.default_speed,
+                                    {params_.tool, params_.user_frame});
   move.data = hses::EncodeWords(words);
   Transact(std::move(move), deadline, timeout);
+  // A controller may answer the move before it sets the running bit: the move is over once the bit
+  // was seen and cleared, or when the arm stands at the target.
+  bool seen_running = false;
   for (;;) {
     hses::Request status;
     status.command = static_cast<std::uint16_t>(hses::Command::kStatusRead);
@@ -278,13 +327,18 @@ void YaskawaHses::MoveUntil(const Eigen::Isometry3d& X_BinTcp, double speed, Tim
     if ((data2 & (hses::kStatus2Alarm | hses::kStatus2Error)) != 0) {
       throw DeviceFault("Yaskawa HSES: alarm/error during move (status data 2 " + Hex(data2, 8) + ")");
     }
-    if ((data1 & hses::kStatus1Running) == 0) {
-      return;
+    if ((data1 & hses::kStatus1Running) != 0) {
+      seen_running = true;
+    } else if (seen_running || AtTarget(PoseUntil(deadline, timeout), X_BinTcp)) {
+      return;  // ran and stopped, or (a short move between two polls) already there
     }
     const auto left = deadline - Clock::now();
     if (left <= Clock::duration::zero()) {
-      throw DeviceTimeout("Yaskawa HSES: move still running after " + std::to_string(timeout.count()) +
-                          " ms");
+      throw DeviceTimeout(
+          seen_running ? "Yaskawa HSES: move still running after " + std::to_string(timeout.count()) + " ms"
+                       : "Yaskawa HSES: move accepted but the arm neither ran nor reached the "
+                         "target within " +
+                             std::to_string(timeout.count()) + " ms");
     }
     std::this_thread::sleep_for(std::min<Clock::duration>(left, params_.poll_interval));
   }

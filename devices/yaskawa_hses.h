@@ -43,6 +43,7 @@ inline constexpr std::int32_t kOff = 2;
 inline constexpr std::uint16_t kStraightAbsolute = 2;
 inline constexpr std::uint16_t kBasePositionInstance = 101;  // robot 1, base coordinates
 inline constexpr std::int32_t kCoordinateBase = 16;
+inline constexpr std::int32_t kCoordinateUser = 18;
 inline constexpr std::int32_t kSpeedClassV = 1;  // V: 0.1 mm/s
 inline constexpr std::size_t kMoveWords = 26;
 inline constexpr std::size_t kPositionWords = 13;
@@ -86,8 +87,17 @@ std::vector<std::int32_t> DecodeWords(std::span<const std::uint8_t> bytes);
 std::array<std::int32_t, 6> PoseToWords(const Eigen::Isometry3d& X_BaseTcp);
 Eigen::Isometry3d PoseFromWords(std::span<const std::int32_t, 6> words);
 
-/// The 26 words of a straight move of robot 1 in base coordinates at `speed` m/s (class V).
-std::array<std::int32_t, kMoveWords> MoveData(const Eigen::Isometry3d& X_BaseTcp, double speed);
+/// The frame and tool a move is given in: base coordinates (user_frame 0) or user frame
+/// `user_frame` (1..63), with tool file `tool` (0..63).
+struct MoveFrame {
+  int tool = 0;
+  int user_frame = 0;
+};
+
+/// The 26 words of a straight move of robot 1 to `X_FrameTcp` (base, or the user frame of `frame`)
+/// at `speed` m/s (class V).
+std::array<std::int32_t, kMoveWords> MoveData(const Eigen::Isometry3d& X_FrameTcp, double speed,
+                                              MoveFrame frame = {});
 
 }  // namespace hses
 
@@ -96,6 +106,15 @@ struct YaskawaHsesParams {
   std::uint16_t port = hses::kDefaultPort;
   /// The bin frame in the robot base frame.
   Eigen::Isometry3d X_BaseBin = Eigen::Isometry3d::Identity();
+  /// Tool file number the TCP is defined by on the controller (0..63).
+  int tool = 0;
+  /// User frame the moves are given in (1..63, as taught on the pendant), or 0: base coordinates.
+  int user_frame = 0;
+  /// That user frame in the base frame (used when user_frame > 0; positions are read in base).
+  Eigen::Isometry3d X_BaseUser = Eigen::Isometry3d::Identity();
+  /// Longest wait for one answer; an unanswered status or position read is sent again within
+  /// the call's timeout (UDP may drop a datagram), a move is not.
+  Timeout request_timeout{500};
   /// Used when MoveTo/MoveThrough get a non-positive speed, m/s.
   double default_speed = 0.1;
   /// Reach (bin frame), tilt and speed limits of this installation (the controller's own soft
@@ -118,6 +137,8 @@ class YaskawaHses final : public Robot {
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) override;
   Eigen::Isometry3d CurrentPose(Timeout timeout) override;
   void ServoOn(Timeout timeout) override;
+  /// Status read (0x72): data 1 running bit, data 2 servo-on, alarm and error bits.
+  std::optional<RobotStatus> Status(Timeout timeout) override;
   RobotLimits Limits() const override { return params_.limits; }
 
   const YaskawaHsesParams& params() const { return params_; }

@@ -79,6 +79,7 @@ class SimRobot final : public Robot {
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) override;
   Eigen::Isometry3d CurrentPose(Timeout timeout) override;
   void ServoOn(Timeout timeout) override;
+  std::optional<RobotStatus> Status(Timeout timeout) override;
   RobotLimits Limits() const override;
 
  private:

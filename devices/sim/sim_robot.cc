@@ -150,6 +150,14 @@ Eigen::Isometry3d SimRobot::CurrentPose(Timeout /*timeout*/) {
   return state_.world->X_BinTcp();
 }
 
+std::optional<RobotStatus> SimRobot::Status(Timeout /*timeout*/) {
+  RobotStatus status;
+  status.servo_on = state_.servo_on;
+  status.alarm = state_.faults[static_cast<std::size_t>(SimDevice::kRobot)] != SimFault::kNone;
+  status.detail = status.servo_on ? "simulated, servo on" : "simulated, servo off";
+  return status;
+}
+
 void SimRobot::ServoOn(Timeout /*timeout*/) {
   state_.ThrowIfInjected(SimDevice::kRobot, "robot");
   state_.servo_on = true;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <thread>
 
 #include "devices/testing/hses_fake.h"
 
@@ -219,6 +220,57 @@ TEST(YaskawaHses, MoveLongerThanTheTimeoutIsADeviceTimeout) {
   const auto start = std::chrono::steady_clock::now();
   EXPECT_THROW(robot.MoveTo(Pose(0.1, 0.0, 0.1, 0, 0, 0), 0.1, 100ms), DeviceTimeout);
   EXPECT_GE(std::chrono::steady_clock::now() - start, 100ms);
+}
+
+TEST(YaskawaHses, MovesInTheConfiguredToolAndUserFrame) {
+  HsesFake fake(10ms);
+  YaskawaHsesParams params = LoopbackParams(fake);
+  params.tool = 3;
+  params.user_frame = 2;
+  params.X_BaseBin = Pose(1.0, 0.0, 0.0, 0, 0, 0);
+  params.X_BaseUser = Pose(1.0, 0.5, 0.0, 0, 0, 90);  // user frame 2: 0.5 m to the side, turned 90°
+  YaskawaHses robot(params);
+  robot.ServoOn(500ms);
+  robot.MoveTo(Pose(0.0, 0.0, 0.3, 180, 0, 0), 0.1, 2000ms);
+  ASSERT_EQ(fake.moves().size(), 1u);
+  const auto& words = fake.moves()[0];
+  EXPECT_EQ(words[4], hses::kCoordinateUser);
+  EXPECT_EQ(words[15], 3) << "tool number";
+  EXPECT_EQ(words[16], 2) << "user frame number";
+  // The bin origin is 0.5 m along -y of the base from the user origin: +0.5 m along the user's x
+  // (turned 90° about z) would be base +y, so the bin lies at user x = -0.5, y = 0.
+  EXPECT_EQ(words[5], -500000);
+  EXPECT_EQ(words[6], 0);
+  EXPECT_EQ(words[7], 300000);
+}
+
+TEST(YaskawaHses, StatusReportsServoAndAlarmBits) {
+  HsesFake fake;
+  YaskawaHses robot(LoopbackParams(fake));
+  std::optional<RobotStatus> status = robot.Status(500ms);
+  ASSERT_TRUE(status);
+  EXPECT_FALSE(status->servo_on);
+  robot.ServoOn(500ms);
+  status = robot.Status(500ms);
+  ASSERT_TRUE(status);
+  EXPECT_TRUE(status->servo_on);
+  EXPECT_FALSE(status->alarm);
+  EXPECT_THAT(status->detail, HasSubstr("data 2 0x"));
+}
+
+TEST(YaskawaHses, AnUnansweredReadIsSentAgainWithinTheCallsTimeout) {
+  HsesFake fake;
+  YaskawaHsesParams params = LoopbackParams(fake);
+  params.request_timeout = 100ms;
+  YaskawaHses robot(params);
+  fake.SetSilent(true);
+  std::thread wake([&] {
+    std::this_thread::sleep_for(250ms);
+    fake.SetSilent(false);
+  });
+  EXPECT_NO_THROW(robot.CurrentPose(2000ms));
+  wake.join();
+  EXPECT_GE(fake.requests().size(), 3u) << "the first reads went unanswered and were sent again";
 }
 
 }  // namespace
