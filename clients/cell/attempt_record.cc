@@ -33,8 +33,9 @@ void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan) {
   record["simulated_displacement"] = plan.simulated_displacement();
 }
 
-nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& reason) {
-  return {{"rank", rank}, {"tube", tube}, {"reason", reason}};
+nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& check,
+                               const std::string& reason) {
+  return {{"rank", rank}, {"tube", tube}, {"check", check}, {"reason", reason}};
 }
 
 nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
@@ -84,22 +85,50 @@ nlohmann::json FaultJson(const CellFault& fault) {
           {"error", fault.error()}};
 }
 
-nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result) {
+nlohmann::json SafeStopRecord(std::uint32_t round, const CellRunResult& result, const std::string& state) {
   nlohmann::json p_Bin_tcp = nullptr;
   if (result.safe_stop && result.safe_stop->p_Bin_tcp) {
     const Eigen::Vector3d& p = *result.safe_stop->p_Bin_tcp;
     p_Bin_tcp = {p.x(), p.y(), p.z()};
   }
-  return {{"type", "safe_stop"},
-          {"round", round},
-          {"device", fault.device()},
-          {"kind", ToString(fault.kind())},
-          {"state", fault.state()},
-          {"error", fault.error()},
-          {"held", ToString(result.safe_stop ? result.safe_stop->held : Held::kNothing)},
-          {"action", result.safe_stop ? result.safe_stop->action : "stopped"},
-          {"p_Bin_tcp", p_Bin_tcp},
-          {"message", result.message}};
+  nlohmann::json record = {{"type", "safe_stop"}, {"round", round}, {"reason", ToString(result.reason)}};
+  if (result.fault) {
+    record["device"] = result.fault->device();
+    record["kind"] = ToString(result.fault->kind());
+    record["state"] = result.fault->state();
+    record["error"] = result.fault->error();
+  } else {
+    record["device"] = "operator";
+    record["kind"] = "stop";
+    record["state"] = state;
+    record["error"] = result.operator_stop.value_or("operator stop");
+  }
+  record["held"] = ToString(result.safe_stop ? result.safe_stop->held : Held::kNothing);
+  record["action"] = result.safe_stop ? result.safe_stop->action : "stopped";
+  record["p_Bin_tcp"] = p_Bin_tcp;
+  record["message"] = result.message;
+  return record;
+}
+
+nlohmann::json OperatorStopJson(const std::string& state, const std::string& why) {
+  return {{"state", state}, {"reason", why}};
+}
+
+nlohmann::json PlannedMotionJson(const PlannedMotion& motion) {
+  nlohmann::json via = nlohmann::json::array();
+  for (const Eigen::Isometry3d& X : motion.via) via.push_back(PoseJson(X));
+  nlohmann::json waypoints = nlohmann::json::array();
+  for (const Eigen::Vector3d& w : motion.waypoints_Bin) waypoints.push_back(VectorJson(w));
+  return {{"kind", ToString(motion.kind)},
+          {"state", ToString(motion.state)},
+          {"step", motion.step},
+          {"tcp_pose", PoseJson(motion.X_BinTcp)},
+          {"via", via},
+          {"waypoints", waypoints},
+          {"speed", motion.speed},
+          {"gripper_opening",
+           motion.gripper_opening ? nlohmann::json(*motion.gripper_opening) : nlohmann::json()},
+          {"gripper_force", motion.gripper_force ? nlohmann::json(*motion.gripper_force) : nlohmann::json()}};
 }
 
 nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const nlohmann::json& truth_start,

@@ -38,8 +38,10 @@ nlohmann::json PlanningDurationsJson(double planning_wall_s, double planning_ser
 /// Adds the plan's tube, trajectory_kind, cost and simulated_displacement to `record`.
 void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan);
 
-/// {"rank", "tube", "reason"}: one entry of skipped_plans.
-nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& reason);
+/// {"rank", "tube", "check", "reason"}: one entry of skipped_plans (check: "cell_frame",
+/// "robot_limits", "tool_clearance").
+nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& check,
+                               const std::string& reason);
 
 /// {"tcp_pose", "approach", "opening_width"}.
 nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
@@ -62,10 +64,19 @@ nlohmann::json NudgeJson(const NudgePlan& nudge);
 /// {"device", "kind", "state", "error"}.
 nlohmann::json FaultJson(const CellFault& fault);
 
-/// {"type": "safe_stop", round, device, kind, state, error, held ("nothing", "tube", "unknown"),
-/// action ("stopped", "released_in_bin", "kept_closed"), p_Bin_tcp (where the TCP ended, or null),
-/// message}.
-nlohmann::json SafeStopRecord(std::uint32_t round, const CellFault& fault, const CellRunResult& result);
+/// {"type": "safe_stop", round, reason ("fault", "stopped"), device, kind, state, error, held
+/// ("nothing", "tube", "unknown"), action ("stopped", "released_in_bin", "kept_closed"), p_Bin_tcp
+/// (where the TCP ended, or null), message}. After a fault: the fault's device, kind, state and
+/// error; after an operator stop (result.operator_stop): device "operator", kind "stop", the state
+/// the stop came in and the operator's reason as error.
+nlohmann::json SafeStopRecord(std::uint32_t round, const CellRunResult& result, const std::string& state);
+
+/// {"state", "reason"}: the "stop" part of an attempt record the operator's stop ended.
+nlohmann::json OperatorStopJson(const std::string& state, const std::string& why);
+
+/// One PlannedMotion as JSON: {"kind", "state", "step", "tcp_pose", "via", "waypoints", "speed",
+/// "gripper_opening", "gripper_force"} (absent parts null or empty).
+nlohmann::json PlannedMotionJson(const PlannedMotion& motion);
 
 /// {"type": "end", round, reason, message, picks, attempts, scans, nudges, lost, truth_start, truth}.
 nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const nlohmann::json& truth_start,

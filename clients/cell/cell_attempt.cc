@@ -8,6 +8,7 @@
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/cell_frame_check.h"
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
 #include "wire/proto_convert.h"
@@ -44,31 +45,47 @@ using detail::PlannerPose;
 
 // ---------------------------------------------------------------- plan
 
-std::optional<std::string> CellController::ClearanceProblem(const v1::PickPlan& plan, int rank) const {
+std::optional<CellController::PlanSkip> CellController::ExecutionProblem(const v1::PlanPickResponse& response,
+                                                                         int rank) const {
+  const v1::PickPlan& plan = response.plans(rank);
   const Eigen::Isometry3d X_BinTcpGrasp =
       PlannerPose(plan.grasp().tcp_pose(), fmt::format("plans[{}].grasp.tcp_pose", rank), state_);
   const std::vector<Eigen::Vector3d> waypoints_Bin = WaypointsOf(plan);
+  const Eigen::Isometry3d X_BinTcpPreGrasp =
+      PreGraspPose(X_BinTcpGrasp, ApproachOf(plan, X_BinTcpGrasp), params_.approach_height);
+  std::optional<Eigen::Isometry3d> X_BinTcpPlace;
+  if (plan.has_place_tcp_pose())
+    X_BinTcpPlace = PlannerPose(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank), state_);
+
+  // This controller's cell first: a plan from a planner with another cell fails everything else
+  // too, with reasons that do not say why.
+  PlanFrameInput frame_input{X_BinTcpGrasp, X_BinTcpPreGrasp, waypoints_Bin, X_BinTcpPlace, nullptr};
+  for (const v1::Tube& tube : response.tubes())
+    if (tube.id() == plan.tube_id()) frame_input.tube = &tube;
+  if (std::optional<std::string> problem = CellFrameProblem(cell_, params_.cell_check, frame_input))
+    return PlanSkip{"cell_frame", std::move(*problem)};
+
   // The arm's reach and wrist limits: pre-grasp, grasp, every lift waypoint and the placement.
   const devices::RobotLimits limits = devices_.robot->Limits();
   std::vector<std::pair<std::string, Eigen::Isometry3d>> X_BinTcp_checked;
-  X_BinTcp_checked.emplace_back(
-      "pre-grasp", PreGraspPose(X_BinTcpGrasp, ApproachOf(plan, X_BinTcpGrasp), params_.approach_height));
+  X_BinTcp_checked.emplace_back("pre-grasp", X_BinTcpPreGrasp);
   X_BinTcp_checked.emplace_back("grasp", X_BinTcpGrasp);
   for (std::size_t i = 0; i < waypoints_Bin.size(); ++i) {
     Eigen::Isometry3d X_BinTcpWaypoint = X_BinTcpGrasp;
     X_BinTcpWaypoint.translation() += waypoints_Bin[i];
     X_BinTcp_checked.emplace_back(fmt::format("waypoint {}", i), X_BinTcpWaypoint);
   }
-  if (plan.has_place_tcp_pose())
-    X_BinTcp_checked.emplace_back(
-        "place", PlannerPose(plan.place_tcp_pose(), fmt::format("plans[{}].place_tcp_pose", rank), state_));
+  if (X_BinTcpPlace) X_BinTcp_checked.emplace_back("place", *X_BinTcpPlace);
   for (const auto& [what, X_BinTcp] : X_BinTcp_checked) {
     const std::string problem = limits.Problem(X_BinTcp);
-    if (!problem.empty()) return fmt::format("robot limits at the {}: {}", what, problem);
+    if (!problem.empty())
+      return PlanSkip{"robot_limits", fmt::format("robot limits at the {}: {}", what, problem)};
   }
   if (!params_.check_tool_clearance) return std::nullopt;
-  return ToolClearanceProblem(cell_, params_.tool, X_BinTcpGrasp, plan.grasp().opening_width(),
-                              waypoints_Bin);
+  if (std::optional<std::string> problem = ToolClearanceProblem(cell_, params_.tool, X_BinTcpGrasp,
+                                                                plan.grasp().opening_width(), waypoints_Bin))
+    return PlanSkip{"tool_clearance", std::move(*problem)};
+  return std::nullopt;
 }
 
 CellController::PlanPoses CellController::PosesOf(const v1::PickPlan& plan, int rank) const {

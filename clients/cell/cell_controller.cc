@@ -26,8 +26,16 @@ const char* ResultName(int result) {
 
 using detail::CallDevice;
 using detail::CallPlanner;
+using detail::CellMismatchMessage;
 using detail::Clock;
 using detail::SecondsSince;
+
+std::string detail::CellMismatchMessage(std::uint32_t plans, const std::string& first_reason) {
+  return fmt::format(
+      "all {} plans of this scan lie outside this controller's cell, none was executed: is the planner "
+      "configured with another cell (bin size, sensor pose, place frame) or unit? The first: {}",
+      plans, first_reason);
+}
 
 std::string ToString(CellState state) {
   switch (state) {
@@ -87,8 +95,30 @@ std::string ToString(CellStopReason reason) {
       return "limit_reached";
     case CellStopReason::kFault:
       return "fault";
+    case CellStopReason::kStopped:
+      return "stopped";
+    case CellStopReason::kDryRun:
+      return "dry_run";
   }
   return "fault";
+}
+
+std::string ToString(MotionKind kind) {
+  switch (kind) {
+    case MotionKind::kTransit:
+      return "transit";
+    case MotionKind::kMoveTo:
+      return "move_to";
+    case MotionKind::kMoveThrough:
+      return "move_through";
+    case MotionKind::kGripperMoveTo:
+      return "gripper_move_to";
+    case MotionKind::kGripperClose:
+      return "gripper_close";
+    case MotionKind::kGripperOpen:
+      return "gripper_open";
+  }
+  return "unknown";
 }
 
 CellController::CellController(CellDevices devices, PlannerClient& planner, CellConfig cell,
@@ -104,6 +134,28 @@ void CellController::Enter(CellState state) {
   state_ = state;
   spdlog::debug("cell: {}", ToString(state));
   if (observer_) observer_(state);
+  CheckStop();
+}
+
+void CellController::RequestStop(std::string why) {
+  {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    if (stop_requested_.load(std::memory_order_relaxed)) return;  // the first reason stays
+    stop_why_ = why.empty() ? "operator stop" : std::move(why);
+  }
+  stop_requested_.store(true, std::memory_order_release);
+}
+
+void CellController::CheckStop() {
+  if (stopping_ || !stop_requested_.load(std::memory_order_acquire)) return;
+  stopping_ = true;
+  std::string why;
+  {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    why = stop_why_;
+  }
+  spdlog::warn("cell: {} during {}", why, ToString(state_));
+  throw StopRequested{why, ToString(state_)};
 }
 
 double CellController::DeviceNow() const { return device_clock_ ? device_clock_() : 0.0; }
@@ -114,21 +166,20 @@ nlohmann::json CellController::Truth() const { return annotator_ ? annotator_() 
 
 CellRunResult CellController::Run(std::uint32_t round) {
   round_ = round;
+  stopping_ = false;
+  commanded_ = false;
+  dry_run_ = false;
+  held_ = Held::kUnknown;
   RunState run;
   const nlohmann::json truth_start = Truth();
-  try {
-    try {
-      StartCell();
-      while (ScanAndPick(run)) {
-      }
-    } catch (const CellFault&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw CellFault("controller", FaultKind::kInternal, ToString(state_), e.what());
+  const std::optional<StopCause> cause = Guarded([&] {
+    StartCell();
+    while (ScanAndPick(run)) {
     }
-  } catch (const CellFault& fault) {
-    RecordFaultedAttempt(run, fault);
-    SafeStop(fault, run.result);
+  });
+  if (cause) {
+    RecordInterruptedAttempt(run, *cause);
+    SafeStop(*cause, run.result);
   }
   if (sink_) sink_->Write(EndRecord(round, run.result, truth_start, Truth()));
   return run.result;
@@ -137,6 +188,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
 /// Servo on, activate and open the gripper, go home, zero the F/T sensor there.
 void CellController::StartCell() {
   Enter(CellState::kStart);
+  commanded_ = true;
   CallDevice("robot", state_, [&] { devices_.robot->ServoOn(params_.robot_timeout); });
   CallDevice("gripper", state_, [&] { devices_.gripper->Activate(params_.gripper_timeout); });
   OpenGripper();
@@ -216,9 +268,10 @@ std::uint32_t CellController::TryPlans(PlannedScan& scan, RunState& run) {
   for (int rank = 0; rank < scan.response.plans_size() && executed < params_.max_plans_per_scan; ++rank) {
     if (executed > 0 && LimitReached(run)) break;
     const v1::PickPlan& plan = scan.response.plans(rank);
-    if (const auto problem = ClearanceProblem(plan, rank)) {
-      spdlog::debug("cell: plan {} (tube {}) skipped: {}", rank, plan.tube_id(), *problem);
-      scan.skipped.push_back(SkippedPlanJson(rank, plan.tube_id(), *problem));
+    if (const std::optional<PlanSkip> skip = ExecutionProblem(scan.response, rank)) {
+      spdlog::debug("cell: plan {} (tube {}) skipped: {}", rank, plan.tube_id(), skip->reason);
+      scan.skipped.push_back(SkippedPlanJson(rank, plan.tube_id(), skip->check, skip->reason));
+      if (skip->check == "cell_frame" && scan.cell_mismatches++ == 0) scan.first_cell_mismatch = skip->reason;
       continue;
     }
     ++executed;
@@ -306,11 +359,21 @@ nlohmann::json CellController::BaseRecord(const PlannedScan& scan, int rank, std
 /// rescan (with the next seed).
 void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
   ++run.consecutive_failures;
-  const std::optional<NudgePlan> nudge = PlanNudgeIfAllowed(scan.response, run);
+  // Every plan lies outside this controller's cell: the planner's tubes are in another frame, so
+  // no nudge either (it would press where the planner, not the bin, has a tube).
+  const bool cell_mismatch = scan.response.plans_size() > 0 &&
+                             scan.cell_mismatches == static_cast<std::uint32_t>(scan.response.plans_size());
+  const std::optional<NudgePlan> nudge =
+      cell_mismatch ? std::nullopt : PlanNudgeIfAllowed(scan.response, run);
   nlohmann::json record = BaseRecord(scan, 0, run.result.attempts);
   record["attempt"] = nullptr;
   record["result"] = "no_plan";
   record["skipped_plans"] = std::exchange(scan.skipped, nlohmann::json::array());
+  if (cell_mismatch) {
+    const std::string message = CellMismatchMessage(scan.cell_mismatches, scan.first_cell_mismatch);
+    record["cell_mismatch"] = message;
+    spdlog::error("cell: round {} scan {}: {}", round_, scan.index, message);
+  }
   record["durations"] = PlanningDurationsJson(scan.planning_wall_s, scan.response.total_seconds());
   if (nudge) record = Nudge(*nudge, std::move(record), scan, run);
   record["durations"]["attempt_wall_s"] = SecondsSince(scan.started);
@@ -357,19 +420,26 @@ nlohmann::json CellController::Nudge(const NudgePlan& nudge, nlohmann::json reco
 
 // ---------------------------------------------------------------- fault (the safe stop: cell_safe_stop.cc)
 
-void CellController::RecordFaultedAttempt(RunState& run, const CellFault& fault) {
+void CellController::RecordInterruptedAttempt(RunState& run, const StopCause& cause) {
   if (!run.active) return;
   run.result.local_analyses += run.active->local_analyses;
   nlohmann::json& record = run.active->record;
-  // A tube already placed when the fault came (on the way home) is a pick, with the fault beside it.
+  // A tube already placed when the fault (or the stop) came, on the way home, is a pick, with the
+  // fault beside it.
   const bool placed = record.value("placed", false);
   if (placed) ++run.result.picks;
-  record["result"] = placed ? "picked" : "fault";
-  record["fault"] = FaultJson(fault);
+  if (cause.fault) {
+    record["result"] = placed ? "picked" : "fault";
+    record["fault"] = FaultJson(*cause.fault);
+  } else {
+    record["result"] = placed ? "picked" : "stopped";
+    record["stop"] = OperatorStopJson(cause.state, cause.why);
+  }
   record["durations"]["robot_wall_s"] = run.active->robot_wall_s;
   record["durations"]["robot_device_s"] = run.active->robot_device_s;
   record["truth_after"] = Truth();
   if (sink_) sink_->Write(record);
+  run.active.reset();
 }
 
 }  // namespace tubepick::cell

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,8 +79,10 @@ enum class CellStopReason {
   kBinEmpty,      ///< the planner reported an empty bin
   kLimitReached,  ///< an attempt limit (per tube, per bin, consecutive failures)
   kFault,         ///< a device or planner fault; a safe stop was performed
+  kStopped,       ///< the operator asked (CellController::RequestStop); a safe stop was performed
+  kDryRun,        ///< CellController::DryRun: scanned and planned, nothing moved
 };
-/// "bin_empty", "limit_reached", "fault".
+/// "bin_empty", "limit_reached", "fault", "stopped", "dry_run".
 std::string ToString(CellStopReason reason);
 
 struct CellRunResult {
@@ -97,9 +101,76 @@ struct CellRunResult {
   std::uint32_t local_analyses = 0;
   /// Set when reason == kFault.
   std::optional<CellFault> fault;
-  /// Set when reason == kFault: what the safe stop did with what the gripper held.
+  /// Set when reason == kStopped: the reason given to RequestStop ("operator stop (SIGINT)").
+  std::optional<std::string> operator_stop;
+  /// Set when reason == kFault or kStopped: what the safe stop did with what the gripper held.
   std::optional<SafeStopOutcome> safe_stop;
 };
+
+/// What a command of a run does (PlannedMotion).
+enum class MotionKind {
+  kTransit,        ///< Robot::MoveTo each pose of `via`, then X_BinTcp, at transit speed (up, across, down)
+  kMoveTo,         ///< Robot::MoveTo X_BinTcp
+  kMoveThrough,    ///< Robot::MoveThrough waypoints_Bin (from the pose before it); X_BinTcp is where it ends
+  kGripperMoveTo,  ///< Gripper::MoveTo gripper_opening
+  kGripperClose,   ///< Gripper::Close
+  kGripperOpen,    ///< Gripper::Open
+};
+/// "transit", "move_to", "move_through", "gripper_move_to", "gripper_close", "gripper_open".
+std::string ToString(MotionKind kind);
+
+/// One command a run would give the robot or the gripper (CellController::DryRun), bin frame.
+struct PlannedMotion {
+  MotionKind kind = MotionKind::kMoveTo;
+  /// The state the run would be in ("approach", "grasp", "lift", "place", "home").
+  CellState state = CellState::kApproach;
+  /// What it is for, for the operator ("transit to the pre-grasp pose", "open to the grasp width", ...).
+  std::string step;
+  /// Robot motions: the TCP pose at the end. Gripper commands: where the TCP is meanwhile.
+  Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
+  /// kTransit: the poses moved to before X_BinTcp (up to transit height, across), in order.
+  std::vector<Eigen::Isometry3d> via;
+  /// kMoveThrough: the TCP translations from the pose before it, bin axes (the first is (0, 0, 0)).
+  std::vector<Eigen::Vector3d> waypoints_Bin;
+  /// TCP speed of robot motions, m/s; closing / opening speed of Gripper::MoveTo and Close, m/s
+  /// (0 for Gripper::Open: the device's own).
+  double speed = 0.0;
+  /// kGripperMoveTo: the width the fingers open to, m.
+  std::optional<double> gripper_opening;
+  /// kGripperMoveTo, kGripperClose: the force, N.
+  std::optional<double> gripper_force;
+};
+
+/// What CellController::DryRun found: the commands the best executable plan of one scan would
+/// give, in order, without any of them given.
+struct DryRunResult {
+  /// kDryRun (planned; `motions` empty when no plan was executable), kBinEmpty, or kFault /
+  /// kStopped (a dry run's safe stop never moves: it only says where the arm is).
+  CellRunResult run;
+  bool bin_empty = false;
+  /// The plan the motions are for: its rank in the planner's answer and its tube.
+  std::optional<std::uint32_t> plan_rank;
+  std::uint32_t tube = 0;
+  /// Plans skipped as a run would skip them: [{"rank", "tube", "check", "reason"}].
+  nlohmann::json skipped_plans = nlohmann::json::array();
+  /// Set when every plan was skipped because it does not fit this controller's cell.
+  std::optional<std::string> cell_mismatch;
+  /// The robot's TCP (it was not moved) and the gripper's status, as read at the start.
+  std::optional<Eigen::Isometry3d> X_BinTcpStart;
+  std::optional<devices::GripperStatus> gripper;
+  /// The commands of the plan's attempt as a run would give them from home, for the outcome
+  /// "one tube held": approach (transit to the pre-grasp pose, open to the grasp width), grasp
+  /// (down, close), lift (the waypoints), place (transit above the place pose, down, open, up),
+  /// home. The other outcomes (nothing grasped or lifted, several tubes) are decided at run time.
+  std::vector<PlannedMotion> motions;
+};
+
+/// The dry run for the operator: how it ended, the plan, and one line per command.
+std::string FormatDryRun(const DryRunResult& dry);
+/// {"reason", "message", "bin_empty", "plan_rank", "tube", "skipped_plans", "cell_mismatch",
+/// "robot_pose", "gripper", "motions": [{"kind", "state", "step", "tcp_pose", "via", "waypoints",
+/// "speed", "gripper_opening", "gripper_force"}]}.
+nlohmann::json DryRunJson(const DryRunResult& dry);
 
 /// The cell controller: runs the pick-and-place cycle of the thesis (§5.1-5.2) until the bin is
 /// empty, a limit is reached or a fault stops it.
@@ -131,13 +202,17 @@ struct CellRunResult {
 /// grasp orientation), which is the thesis' "reference with no object held" without the drift and
 /// orientation change between the start of a round and a later pick.
 ///
-/// Plans the arm cannot reach (Robot::Limits: pre-grasp, grasp, lift waypoints, placement) or the tool
-/// cannot execute without touching the bin (ToolClearanceProblem) are skipped and
-/// listed in the next record's skipped_plans; a scan without an executable plan is a "no_plan"
-/// record and a rescan — or, when the planner modeled a tube lying along a wall (PlanNudge) and the
-/// nudge limit allows, a "nudge": close the gripper, press on the tube's top, drag it away from the
-/// wall, open at the top, go home and rescan. A scan that ends in a nudge counts as a consecutive
-/// failure (not as a picking attempt); max_nudges_per_bin bounds them per run.
+/// Plans that do not fit this controller's cell (CellFrameProblem: a grasp, pre-grasp or lift waypoint
+/// outside its bin, a place pose away from its place frame: a planner configured with another cell
+/// or in millimetres), that the arm cannot reach (Robot::Limits: pre-grasp, grasp, lift waypoints,
+/// placement) or the tool cannot execute without touching the bin (ToolClearanceProblem) are
+/// skipped before any motion and listed in the next record's skipped_plans ({rank, tube, check:
+/// "cell_frame" | "robot_limits" | "tool_clearance", reason}); when every plan of a scan was skipped
+/// as not fitting the cell, its "no_plan" record says so (cell_mismatch) and no nudge is tried; a scan
+/// without an executable plan is a "no_plan" record and a rescan — or, when the planner modeled a tube lying
+/// along a wall (PlanNudge) and the nudge limit allows, a "nudge": close the gripper, press on the tube's
+/// top, drag it away from the wall, open at the top, go home and rescan. A scan that ends in a nudge counts
+/// as a consecutive failure (not as a picking attempt); max_nudges_per_bin bounds them per run.
 ///
 /// Every picking attempt (and every scan without a plan) is one record ("type": "attempt"):
 ///   round, attempt, scan, plan_rank, seed, tubes_left_plan (tubes the planner modeled),
@@ -153,9 +228,18 @@ struct CellRunResult {
 /// A safe stop writes {"type": "safe_stop", ...}; every run ends with {"type": "end", reason,
 /// message, picks, attempts, scans, nudges, truth}.
 ///
+/// The operator stops a run with RequestStop (from any thread): the run notices it at its next state
+/// or robot motion and ends through the same safe stop a fault uses (a held tube is released over
+/// the bin), with reason kStopped; the attempt under way is recorded with result "stopped", the
+/// safe_stop record has device "operator", kind "stop" and the reason given.
+///
+/// DryRun scans and plans once without moving anything and returns the commands the best executable
+/// plan would give (DryRunResult), with a {"type": "dry_run", ...} record (DryRunJson's fields).
+///
 /// Poses are named for their frames: X_BinTcp… is a TCP pose in the bin frame (X_BinTcpGrasp,
 /// X_BinTcpPreGrasp, X_BinTcpLift, X_BinTcpPlace, X_BinHome), p_Bin_… a position in it. The source
-/// is cut by step: cell_controller.cc (the run: start, scan, plan, attempts, nudge), cell_safe_stop.cc,
+/// is cut by step: cell_controller.cc (the run: start, scan, plan, attempts, nudge, stop requests),
+/// cell_dry_run.cc, cell_frame_check.cc (plans against this cell), cell_safe_stop.cc,
 /// cell_attempt.cc (one attempt: approach … place / resolve / put back), cell_device_calls.cc (the
 /// device and planner calls), attempt_record.cc (the records' parts).
 class CellController {
@@ -177,6 +261,22 @@ class CellController {
   /// kFault result.
   CellRunResult Run(std::uint32_t round = 0);
 
+  /// Scans and plans once, moving nothing: no servo on, no robot motion, no gripper command (the
+  /// robot's pose and the gripper's status are read); then lists the commands a run would give for
+  /// the best plan it would execute (the same skipping rules), in the bin frame. Writes one
+  /// {"type": "dry_run"} record. Never throws for device or planner failures (kFault, no motion).
+  DryRunResult DryRun(std::uint32_t round = 0);
+
+  /// Asks the run under way (or the next one) to stop: at its next state or robot motion it ends
+  /// through the safe stop, with reason kStopped and a message naming `why` (e.g. "operator stop
+  /// (SIGINT)"). Thread-safe: may be called from any thread, any number of times (the first reason
+  /// stays); not async-signal-safe (a signal handler sets a flag that a thread turns into this
+  /// call). A device or planner call under way is not interrupted: the stop comes when it returns
+  /// (a PlanPick may take up to plan_deadline). A stop before anything was commanded moves nothing.
+  /// The controller stays stopped: a later Run or DryRun stops at its first state.
+  void RequestStop(std::string why);
+  bool stop_requested() const { return stop_requested_.load(std::memory_order_acquire); }
+
   /// The state the controller is in (kSafeStop after a fault).
   CellState state() const { return state_; }
 
@@ -186,9 +286,19 @@ class CellController {
   struct PlannedScan;  ///< one scan and the planner's answer to it
   struct PlanPoses;    ///< the TCP poses of one plan, bin frame
   enum class AttemptResult { kPicked, kMultipleReturned, kNone, kGraspFailed, kLost };
-  struct TubeLost;  ///< thrown inside an attempt when the held tube is gone
+  struct TubeLost;       ///< thrown inside an attempt when the held tube is gone
+  struct StopRequested;  ///< thrown at a state or a motion after RequestStop
+  struct StopCause;      ///< why a run ends in the safe stop: a fault or the operator
+  /// Why a plan is skipped: which check ("cell_frame", "robot_limits", "tool_clearance") and why.
+  struct PlanSkip {
+    std::string check;
+    std::string reason;
+  };
 
   // The run (cell_controller.cc): start, then scan → plan → attempts or a nudge, until a stop.
+  /// Runs `body`; a fault or a stop request it throws is returned (other exceptions: an internal fault).
+  template <typename Body>
+  std::optional<StopCause> Guarded(Body&& body);
   void StartCell();
   /// Why no further attempt may be made (an attempt limit), or nullopt.
   std::optional<std::string> LimitReached(const RunState& run) const;
@@ -210,9 +320,12 @@ class CellController {
   nlohmann::json Nudge(const NudgePlan& nudge, nlohmann::json record, const PlannedScan& scan, RunState& run);
   /// The "type": "attempt" record's common fields; truth_before is the scan's for rank 0.
   nlohmann::json BaseRecord(const PlannedScan& scan, int rank, std::uint32_t attempt);
-  /// The attempt under way when `fault` stopped the run, recorded as "fault".
-  void RecordFaultedAttempt(RunState& run, const CellFault& fault);
-  void SafeStop(const CellFault& fault, CellRunResult& result);
+  /// The attempt under way when `cause` stopped the run, recorded as "fault" or "stopped".
+  void RecordInterruptedAttempt(RunState& run, const StopCause& cause);
+  /// The safe stop after a fault or an operator stop; sets result's reason, message and safe_stop.
+  void SafeStop(const StopCause& cause, CellRunResult& result);
+  /// Throws StopRequested when a stop was requested and the run is not stopping already.
+  void CheckStop();
   /// Holding: over the bin, down to the release height, open, up; says what it did and could not.
   std::string ReturnHeldTubeToBin(SafeStopOutcome& outcome);
   /// The release pose over the bin's middle, x_Tcp turned (about the vertical) along the bin's long
@@ -221,10 +334,13 @@ class CellController {
 
   // One picking attempt (cell_attempt.cc): approach, reference, grasp, lift, analyze, then place,
   // resolve or put back.
-  /// Why a plan cannot be executed: a pose beyond the robot's limits, or ToolClearanceProblem (when
-  /// that check is on); nullopt when it can.
-  std::optional<std::string> ClearanceProblem(const v1::PickPlan& plan, int rank) const;
+  /// Why plan `rank` of `response` cannot be executed: it does not fit this controller's cell
+  /// (CellFrameProblem, when params.cell_check is on), a pose is beyond the robot's limits, or
+  /// ToolClearanceProblem (when that check is on); nullopt when it can.
+  std::optional<PlanSkip> ExecutionProblem(const v1::PlanPickResponse& response, int rank) const;
   PlanPoses PosesOf(const v1::PickPlan& plan, int rank) const;
+  /// The commands ExecutePlan gives for `poses` from home when one tube is held (DryRun).
+  std::vector<PlannedMotion> PlannedMotions(const PlanPoses& poses, double opening_width) const;
   void ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& attempt);
   void Approach(const Eigen::Isometry3d& X_BinTcpPreGrasp, double opening_width, Attempt& attempt);
   devices::WrenchReading TakeReference(Attempt& attempt);
@@ -269,6 +385,10 @@ class CellController {
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed, Attempt* attempt);
   Eigen::Isometry3d CurrentPose();
+  /// The poses TransitTo moves through from X_BinTcpFrom: up to transit height (if below it),
+  /// across, down to X_BinTcpTo (if below it); the last is X_BinTcpTo.
+  std::vector<Eigen::Isometry3d> TransitSegments(const Eigen::Isometry3d& X_BinTcpFrom,
+                                                 const Eigen::Isometry3d& X_BinTcpTo) const;
   /// Up to transit height, across, down to `X_BinTcp`; `after_each` (if set) runs after every segment.
   void TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt,
                  const std::function<void()>& after_each = {});
@@ -306,6 +426,16 @@ class CellController {
   CellState state_ = CellState::kStart;
   Held held_ = Held::kUnknown;
   std::uint32_t round_ = 0;
+  /// A stop was requested (RequestStop); stop_why_ (under stop_mutex_) is set before it.
+  std::atomic<bool> stop_requested_{false};
+  mutable std::mutex stop_mutex_;
+  std::string stop_why_;
+  /// The run is in its safe stop (no further stop checks).
+  bool stopping_ = false;
+  /// The run has commanded a device that may move (servo on): before that a stop moves nothing.
+  bool commanded_ = false;
+  /// DryRun under way: nothing may move, not even in a safe stop.
+  bool dry_run_ = false;
 };
 
 }  // namespace tubepick::cell

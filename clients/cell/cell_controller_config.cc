@@ -73,6 +73,16 @@ void DescribeFields(Visit& v, NudgeParams& n) {
   v("sample_spacing", n.sample_spacing, "m along the tube");
 }
 
+template <typename Visit>
+void DescribeFields(Visit& v, CellFrameCheckParams& c) {
+  v("enabled", c.enabled, "check every plan against this controller's cell before any motion");
+  v("bin_margin", c.bin_margin, "m: grasp in the bin's interior, pre-grasp and lift over it, grown by this");
+  v("place_position_tolerance", c.place_position_tolerance,
+    "m between the place frame a plan implies and this cell's place frame");
+  v("place_rotation_tolerance", c.place_rotation_tolerance,
+    "rad, the same for the turn (a half turn about z is the same frame)");
+}
+
 namespace {
 
 template <typename Visit>
@@ -95,6 +105,9 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   ToolSection tool{p.tool};
   v.Section("tool", tool, "tool boxes in the TCP frame, m (the planner's planning.tool)");
   v.Section("nudge", p.nudge, "drag a tube off a wall when no plan is executable");
+  v.Section("cell_check", p.cell_check,
+            "plans checked against this controller's bin and place frame (cell YAML): a planner\n"
+            "configured with another cell (bin size, place frame, millimetres) must not drive the arm");
 }
 
 template <typename Visit>

@@ -63,6 +63,9 @@ inline Eigen::Isometry3d WithHeight(Eigen::Isometry3d X, double z) {
 
 constexpr double kSameHeight = 1e-4;  // m: moves shorter than this are skipped
 
+/// The "no_plan" record's cell_mismatch: every one of `plans` skipped as not fitting the cell.
+std::string CellMismatchMessage(std::uint32_t plans, const std::string& first_reason);
+
 }  // namespace detail
 
 /// One picking attempt (or nudge) under way: its record and its running durations.
@@ -86,6 +89,21 @@ struct CellController::TubeLost : std::runtime_error {
   std::string detected_by;  ///< "gripper_status" or "wrench"
 };
 
+/// Thrown at a state or before a robot motion once RequestStop was called (not a std::exception:
+/// no catch of device errors on the way swallows it).
+struct CellController::StopRequested {
+  std::string why;
+  std::string state;
+};
+
+/// Why a run ends in the safe stop: a fault (device, planner, internal) or the operator.
+struct CellController::StopCause {
+  std::optional<CellFault> fault;
+  /// The operator's reason (RequestStop) and the state the stop was noticed in, when no fault.
+  std::string why;
+  std::string state;
+};
+
 /// One run (one bin): its result so far, the counters the attempt limits look at and the attempt
 /// under way (recorded as "fault" when a fault stops the run).
 struct CellController::RunState {
@@ -96,6 +114,26 @@ struct CellController::RunState {
   std::optional<Attempt> active;
 };
 
+template <typename Body>
+std::optional<CellController::StopCause> CellController::Guarded(Body&& body) {
+  try {
+    try {
+      body();
+      return std::nullopt;
+    } catch (const CellFault&) {
+      throw;
+    } catch (const StopRequested&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw CellFault("controller", FaultKind::kInternal, ToString(state_), e.what());
+    }
+  } catch (const CellFault& fault) {
+    return StopCause{fault, "", fault.state()};
+  } catch (const StopRequested& stop) {
+    return StopCause{std::nullopt, stop.why, stop.state};
+  }
+}
+
 /// One scan and the planner's answer to it; its time counts towards the scan's first attempt.
 struct CellController::PlannedScan {
   std::uint32_t index = 0;  ///< scans before this one in the run
@@ -104,8 +142,11 @@ struct CellController::PlannedScan {
   double device_started = 0.0;
   v1::PlanPickResponse response;
   double planning_wall_s = 0.0;
-  /// Plans skipped since the last attempt (rank, tube, reason), for the next record.
+  /// Plans skipped since the last attempt (rank, tube, check, reason), for the next record.
   nlohmann::json skipped = nlohmann::json::array();
+  /// Plans of this scan skipped because they do not fit this controller's cell, and the first reason.
+  std::uint32_t cell_mismatches = 0;
+  std::string first_cell_mismatch;
 };
 
 /// The TCP poses of one plan, bin frame.

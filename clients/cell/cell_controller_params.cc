@@ -78,6 +78,7 @@ void CellControllerParams::Validate() const {
         fmt::format("cell controller nudge.tilt: must be in [0, pi/2) rad, got {}", nudge.tilt));
   RequirePositiveValue(nudge.speed, "nudge.speed");
   RequirePositiveValue(nudge.sample_spacing, "nudge.sample_spacing");
+  cell_check.Validate();
   RequirePositiveValue(gripper_speed, "gripper_speed");
   RequirePositiveValue(gripper_force, "gripper_force");
   RequirePositiveCount(ft_samples, "ft_samples");

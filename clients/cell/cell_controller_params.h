@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "clients/cell/cell_frame_check.h"
 #include "clients/cell/nudge.h"
 #include "clients/cell/tool_clearance.h"
 #include "core/common/cell_config.h"
@@ -55,6 +56,11 @@ struct CellControllerParams {
   /// The nudge skill for a scan whose tubes have no executable plan (see NudgeParams); it needs
   /// check_tool_clearance (its moves are checked with `tool`).
   NudgeParams nudge;
+  /// Every plan's grasp, pre-grasp, lift waypoints and place pose are checked against this
+  /// controller's own cell (its bin and place frame) before any motion; a plan that does not fit
+  /// is skipped with the reason (CellFrameCheckParams): a planner configured with another cell
+  /// (bin size, place frame, millimetres) must not drive the arm.
+  CellFrameCheckParams cell_check;
 
   // --- gripper ---
   /// Closing speed (m/s) and force (N) (Robotiq 2F-85: 0.02-0.15 m/s, 20-235 N).

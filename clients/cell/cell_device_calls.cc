@@ -72,6 +72,7 @@ devices::Capture CellController::Scan() {
 
 template <typename Motion>
 void CellController::TimedRobotMotion(Attempt* attempt, const Motion& motion) {
+  CheckStop();  // between motions: an operator stop does not wait for the next state
   const Clock::time_point start = Clock::now();
   const double device_start = DeviceNow();
   CallDevice("robot", state_, motion);
@@ -95,18 +96,24 @@ Eigen::Isometry3d CellController::CurrentPose() {
   return CallDevice("robot", state_, [&] { return devices_.robot->CurrentPose(params_.robot_timeout); });
 }
 
+std::vector<Eigen::Isometry3d> CellController::TransitSegments(const Eigen::Isometry3d& X_BinTcpFrom,
+                                                               const Eigen::Isometry3d& X_BinTcpTo) const {
+  const double z_transit =
+      std::max({TransitHeight(params_, cell_), X_BinTcpFrom.translation().z(), X_BinTcpTo.translation().z()});
+  std::vector<Eigen::Isometry3d> segments;
+  if (X_BinTcpFrom.translation().z() < z_transit - kSameHeight)
+    segments.push_back(WithHeight(X_BinTcpFrom, z_transit));
+  segments.push_back(WithHeight(X_BinTcpTo, z_transit));
+  if (X_BinTcpTo.translation().z() < z_transit - kSameHeight) segments.push_back(X_BinTcpTo);
+  return segments;
+}
+
 void CellController::TransitTo(const Eigen::Isometry3d& X_BinTcp, Attempt* attempt,
                                const std::function<void()>& after_each) {
-  const Eigen::Isometry3d X_BinTcpNow = CurrentPose();
-  const double z_transit =
-      std::max({TransitHeight(params_, cell_), X_BinTcpNow.translation().z(), X_BinTcp.translation().z()});
-  const auto segment = [&](const Eigen::Isometry3d& X_BinTcpTo) {
+  for (const Eigen::Isometry3d& X_BinTcpTo : TransitSegments(CurrentPose(), X_BinTcp)) {
     MoveTo(X_BinTcpTo, params_.transit_speed, attempt);
     if (after_each) after_each();
-  };
-  if (X_BinTcpNow.translation().z() < z_transit - kSameHeight) segment(WithHeight(X_BinTcpNow, z_transit));
-  segment(WithHeight(X_BinTcp, z_transit));
-  if (X_BinTcp.translation().z() < z_transit - kSameHeight) segment(X_BinTcp);
+  }
 }
 
 devices::GripperStatus CellController::CheckGripper(const devices::GripperStatus& status) {

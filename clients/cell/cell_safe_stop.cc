@@ -25,16 +25,27 @@ using detail::WithHeight;
 
 /// Nothing held: stop where the arm is. Holding (or not sure): back over the bin, down into it and
 /// open; when the arm or the gripper cannot do that, keep the gripper closed and say where the tube
-/// is held. Never throws, never opens the gripper outside the bin.
-void CellController::SafeStop(const CellFault& fault, CellRunResult& result) {
+/// is held. A dry run, or a stop before anything was commanded, moves nothing. Never throws, never
+/// opens the gripper outside the bin.
+void CellController::SafeStop(const StopCause& cause, CellRunResult& result) {
+  stopping_ = true;  // no stop check from here on
   Enter(CellState::kSafeStop);
-  spdlog::error("cell: {}", fault.what());
+  if (cause.fault)
+    spdlog::error("cell: {}", cause.fault->what());
+  else
+    spdlog::warn("cell: {} during {}: safe stop", cause.why, cause.state);
   SafeStopOutcome outcome;
   outcome.held = held_;
   std::string note;
-  if (held_ == Held::kNothing) {
+  const bool may_move = !dry_run_ && commanded_;
+  if (held_ == Held::kNothing || !may_move) {
     outcome.action = "stopped";
-    note = "nothing held: stopped where it is";
+    if (dry_run_)
+      note = fmt::format("dry run: nothing moved (the gripper holds {})", ToString(held_));
+    else if (!commanded_)
+      note = "stopped before the cell started: nothing moved";
+    else
+      note = "nothing held: stopped where it is";
     try {
       outcome.p_Bin_tcp = devices_.robot->CurrentPose(params_.robot_timeout).translation();
       note += fmt::format(" (X_BinTcp at {})", FormatPosition(*outcome.p_Bin_tcp));
@@ -44,13 +55,21 @@ void CellController::SafeStop(const CellFault& fault, CellRunResult& result) {
   } else {
     note = ReturnHeldTubeToBin(outcome);
   }
-  result.reason = CellStopReason::kFault;
-  result.fault = fault;
   result.safe_stop = outcome;
-  result.message = fmt::format("SAFE STOP: {} {} during {}: {}; {}", fault.device(), ToString(fault.kind()),
-                               fault.state(), fault.error(), note);
-  spdlog::error("cell: {}", result.message);
-  if (sink_) sink_->Write(SafeStopRecord(round_, fault, result));
+  if (cause.fault) {
+    const CellFault& fault = *cause.fault;
+    result.reason = CellStopReason::kFault;
+    result.fault = fault;
+    result.message = fmt::format("SAFE STOP: {} {} during {}: {}; {}", fault.device(), ToString(fault.kind()),
+                                 fault.state(), fault.error(), note);
+    spdlog::error("cell: {}", result.message);
+  } else {
+    result.reason = CellStopReason::kStopped;
+    result.operator_stop = cause.why;
+    result.message = fmt::format("STOPPED: {} during {}; {}", cause.why, cause.state, note);
+    spdlog::warn("cell: {}", result.message);
+  }
+  if (sink_) sink_->Write(SafeStopRecord(round_, result, cause.state));
 }
 
 Eigen::Isometry3d CellController::SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const {

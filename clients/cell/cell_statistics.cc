@@ -79,6 +79,7 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
         if (truth && reason == "bin_empty" && !emptied) ++s.false_empty;
         if (reason == "limit_reached") ++s.limit_stops;
         if (reason == "fault") ++s.fault_stops;
+        if (reason == "stopped") ++s.operator_stops;
         if (HasTruth(r.value("truth_start", json())))
           s.tubes_total += r["truth_start"]["tubes_in_bin"].get<std::uint32_t>();
         continue;
@@ -173,6 +174,7 @@ json StatisticsJson(const CellStatistics& s) {
           {"false_empty", s.false_empty},
           {"limit_stops", s.limit_stops},
           {"fault_stops", s.fault_stops},
+          {"operator_stops", s.operator_stops},
           {"tubes_total", s.tubes_total},
           {"picks", s.picks},
           {"tubes_lost", s.tubes_lost},

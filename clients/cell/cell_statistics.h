@@ -54,6 +54,8 @@ struct CellStatistics {
   std::uint32_t false_empty = 0;
   std::uint32_t limit_stops = 0;
   std::uint32_t fault_stops = 0;
+  /// Rounds the operator stopped (CellController::RequestStop).
+  std::uint32_t operator_stops = 0;
   /// Tubes in the bins at the start (ground truth; 0 without it).
   std::uint32_t tubes_total = 0;
   /// Attempts that ended in "picked".

@@ -44,6 +44,10 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.nudge.tilt, b.nudge.tilt);
   EXPECT_EQ(a.nudge.speed, b.nudge.speed);
   EXPECT_EQ(a.nudge.sample_spacing, b.nudge.sample_spacing);
+  EXPECT_EQ(a.cell_check.enabled, b.cell_check.enabled);
+  EXPECT_EQ(a.cell_check.bin_margin, b.cell_check.bin_margin);
+  EXPECT_EQ(a.cell_check.place_position_tolerance, b.cell_check.place_position_tolerance);
+  EXPECT_EQ(a.cell_check.place_rotation_tolerance, b.cell_check.place_rotation_tolerance);
   EXPECT_EQ(a.gripper_speed, b.gripper_speed);
   EXPECT_EQ(a.gripper_force, b.gripper_force);
   EXPECT_EQ(a.ft_settle_samples, b.ft_settle_samples);
@@ -132,6 +136,10 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.nudge.speed = 0.04;
   p.nudge.sample_spacing = 0.01;
   p.gripper_speed = 0.07;
+  p.cell_check.enabled = false;
+  p.cell_check.bin_margin = 0.035;
+  p.cell_check.place_position_tolerance = 0.08;
+  p.cell_check.place_rotation_tolerance = 0.25;
   p.ft_samples = 9;
   p.max_plans_per_scan = 3;
   p.max_attempts_per_tube = 5;
@@ -239,6 +247,32 @@ TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
   EXPECT_NE(ParseError("ft_spike_torque: .nan\n").find("ft_spike_torque"), std::string::npos);
   EXPECT_NE(ParseError("scan_retries: -1\n").find("scan_retries"), std::string::npos);
   EXPECT_NE(ParseError("ft_read_retries: two\n").find("ft_read_retries"), std::string::npos);
+}
+
+TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {
+  const CellControllerParams p =
+      ParseCellControllerParams("cell_check:\n  bin_margin: 0.05\n  place_rotation_tolerance: 0.2\n");
+  EXPECT_EQ(p.cell_check.bin_margin, 0.05);
+  EXPECT_EQ(p.cell_check.place_rotation_tolerance, 0.2);
+  EXPECT_TRUE(p.cell_check.enabled);
+  EXPECT_EQ(p.cell_check.place_position_tolerance, CellFrameCheckParams{}.place_position_tolerance);
+  const std::string yaml = DumpCellControllerParams(CellControllerParams{});
+  EXPECT_NE(yaml.find("cell_check:"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("place_position_tolerance: 0.05"), std::string::npos) << yaml;
+
+  EXPECT_NE(ParseError("cell_check:\n  bin_margin: -0.01\n")
+                .find("cell_check.bin_margin: must be a non-negative number, got -0.01"),
+            std::string::npos)
+      << ParseError("cell_check:\n  bin_margin: -0.01\n");
+  EXPECT_NE(ParseError("cell_check:\n  place_position_tolerance: .nan\n")
+                .find("cell_check.place_position_tolerance"),
+            std::string::npos);
+  EXPECT_NE(ParseError("cell_check:\n  place_rotation_tolerance: 20\n")
+                .find("cell_check.place_rotation_tolerance: must be in [0, pi] rad, got 20 (degrees?)"),
+            std::string::npos)
+      << ParseError("cell_check:\n  place_rotation_tolerance: 20\n");
+  EXPECT_NE(ParseError("cell_check:\n  margin: 0.1\n").find("cell_check.margin"), std::string::npos);
+  EXPECT_NE(ParseError("cell_check:\n  enabled: perhaps\n").find("cell_check.enabled"), std::string::npos);
 }
 
 TEST(CellControllerConfigTest, LoadNamesTheFile) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/test/scripted_cell.h"
 #include "core/common/errors.h"
@@ -44,7 +46,19 @@ class CellControllerTest : public ::testing::Test {
   CellRunResult Run() {
     CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
     if (observer) controller.set_state_observer(observer);
-    return controller.Run(3);
+    running = &controller;
+    const CellRunResult result = controller.Run(3);
+    running = nullptr;
+    return result;
+  }
+
+  DryRunResult DryRun() {
+    CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
+    if (observer) controller.set_state_observer(observer);
+    running = &controller;
+    const DryRunResult result = controller.DryRun(3);
+    running = nullptr;
+    return result;
   }
 
   std::vector<json> Records(const std::string& type) const {
@@ -68,6 +82,8 @@ class CellControllerTest : public ::testing::Test {
   CellConfig cell;
   CellControllerParams params;
   std::function<void(CellState)> observer;
+  /// The controller of the Run / DryRun under way (for an observer that asks it to stop).
+  CellController* running = nullptr;
   const Eigen::Vector3d p_Bin_grasp{0.1, -0.05, 0.03};
 };
 
@@ -838,9 +854,9 @@ TEST_F(PlaceFaultTest, NoLoadAboveThePlaceIsALostTubeEvenWhenTheGripperSaysHoldi
   EXPECT_FALSE(robot.Visited(testing::PlacePose()));
 }
 
-TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
+TEST_F(CellControllerTest, RealClientWithNoServerWaitsItsBudgetThenSafeStops) {
   GrpcPlannerClientOptions options;
-  options.max_retries = 2;
+  options.unavailable_budget = std::chrono::milliseconds(200);
   options.initial_backoff = std::chrono::milliseconds(5);
   options.max_backoff = std::chrono::milliseconds(10);
   GrpcPlannerClient client("127.0.0.1:1", options);  // nothing listens on port 1
@@ -849,7 +865,9 @@ TEST_F(CellControllerTest, RealClientWithNoServerRetriesThenSafeStops) {
   const CellRunResult result = controller.Run();
   ASSERT_TRUE(result.fault);
   EXPECT_EQ(result.fault->kind(), FaultKind::kServerUnavailable);
-  EXPECT_NE(result.message.find("PlanPick failed after 3 tries: UNAVAILABLE"), std::string::npos)
+  EXPECT_NE(result.message.find("PlanPick failed after 1 try: UNAVAILABLE: no connection to the planner at "
+                                "127.0.0.1:1 within 0.2 s (unavailable_budget)"),
+            std::string::npos)
       << result.message;
   EXPECT_EQ(controller.state(), CellState::kSafeStop);
 }
@@ -862,6 +880,331 @@ TEST_F(CellControllerTest, UnusablePlanIsAServerError) {
   ASSERT_TRUE(result.fault);
   EXPECT_EQ(result.fault->kind(), FaultKind::kServerError);
   EXPECT_NE(result.message.find("plans[0].waypoints: empty"), std::string::npos) << result.message;
+}
+
+// ---------------------------------------------------------------- plans against this cell
+
+/// `plan` as a planner in millimetres sends it: every length × 1000.
+v1::PickPlan InMillimetres(v1::PickPlan plan) {
+  const auto scale = [](v1::Vector3* v) {
+    v->set_x(v->x() * 1000.0);
+    v->set_y(v->y() * 1000.0);
+    v->set_z(v->z() * 1000.0);
+  };
+  scale(plan.mutable_grasp()->mutable_tcp_pose()->mutable_position());
+  for (v1::Vector3& w : *plan.mutable_waypoints()) scale(&w);
+  scale(plan.mutable_place_tcp_pose()->mutable_position());
+  return plan;
+}
+
+TEST_F(CellControllerTest, APlannerInMillimetresDoesNotDriveTheArm) {
+  planner.plan_answers.push_back(Plans(
+      {InMillimetres(MakePlan(1, p_Bin_grasp)), InMillimetres(MakePlan(2, Eigen::Vector3d(0.0, 0.0, 0.02)))},
+      2));
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 0u);
+  EXPECT_EQ(gripper.closes, 0);  // no grasp, no nudge
+  EXPECT_EQ(robot.throughs, 0);
+  for (const testing::ScriptedRobot::Move& m : robot.moves)  // only the way home at the start
+    EXPECT_GE(m.X_BinTcpTarget.translation().z(), 0.5 - kTol);
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["result"], "no_plan");
+  ASSERT_EQ(records[0]["skipped_plans"].size(), 2u);
+  const json& skipped = records[0]["skipped_plans"][0];
+  EXPECT_EQ(skipped["check"], "cell_frame");
+  const std::string reason = skipped["reason"];
+  EXPECT_NE(
+      reason.find("cell check: the grasp at (100.000, -50.000, 30.000) m lies outside this controller's "
+                  "bin (inner 0.800 x 0.600 x 0.200 m"),
+      std::string::npos)
+      << reason;
+  EXPECT_NE(reason.find("millimetres read as metres"), std::string::npos) << reason;
+  const std::string mismatch = records[0]["cell_mismatch"];
+  EXPECT_NE(mismatch.find("all 2 plans of this scan lie outside this controller's cell"), std::string::npos)
+      << mismatch;
+}
+
+TEST_F(CellControllerTest, APlannerWithAnotherBinSizeHasItsOutsideGraspsSkipped) {
+  cell.bin.inner_size = Eigen::Vector3d(0.5, 0.4, 0.2);  // the controller's bin; the planner's is 0.8 x 0.6
+  const Eigen::Vector3d p_Bin_far(0.32, 0.1, 0.03);
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_far), MakePlan(2, p_Bin_grasp)}, 3));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_FALSE(robot.Visited(DownPose(p_Bin_far)));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["tube"], 2);
+  ASSERT_EQ(a["skipped_plans"].size(), 1u);
+  EXPECT_EQ(a["skipped_plans"][0]["check"], "cell_frame");
+  const std::string reason = a["skipped_plans"][0]["reason"];
+  EXPECT_NE(reason.find("the grasp at (0.320, 0.100, 0.030) m lies outside this controller's bin"),
+            std::string::npos)
+      << reason;
+  EXPECT_NE(reason.find("|x| > 0.270 m"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("another bin (cell bin.inner_size)"), std::string::npos) << reason;
+  EXPECT_FALSE(a.contains("cell_mismatch"));
+}
+
+TEST_F(CellControllerTest, APlannerWithAnotherPlaceFrameDoesNotDriveTheArm) {
+  cell.place.X_BinPlace = Eigen::Isometry3d(Eigen::Translation3d(0.7, -0.9, 0.1));
+  params.nudge.enabled = true;
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 0u);
+  EXPECT_EQ(gripper.closes, 0);
+  const json record = Records("attempt").at(0);
+  EXPECT_EQ(record["result"], "no_plan");
+  const std::string reason = record["skipped_plans"][0]["reason"];
+  EXPECT_NE(
+      reason.find("cell check: the place pose at (0.000, 0.800, 0.120) m is 1.839 m from this controller's "
+                  "place frame at (0.700, -0.900, 0.100) m"),
+      std::string::npos)
+      << reason;
+  EXPECT_NE(reason.find("another place frame (cell place.pose_in_bin)"), std::string::npos) << reason;
+  EXPECT_TRUE(record.contains("cell_mismatch"));
+  // Without the check the plan would be executed.
+  params.cell_check.enabled = false;
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  EXPECT_EQ(Run().attempts, 1u);
+}
+
+// ---------------------------------------------------------------- operator stop
+
+TEST_F(CellControllerTest, StopWhileHoldingATubeReleasesItOverTheBin) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  observer = [this](CellState state) {
+    if (state == CellState::kAnalyze) running->RequestStop("operator stop (SIGINT)");
+  };
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kStopped);
+  EXPECT_FALSE(result.fault);
+  ASSERT_TRUE(result.operator_stop);
+  EXPECT_EQ(*result.operator_stop, "operator stop (SIGINT)");
+  EXPECT_EQ(
+      result.message.rfind("STOPPED: operator stop (SIGINT) during analyze; a tube released into the bin "
+                           "at X_BinTcp (0.000, 0.000, 0.150) m",
+                           0),
+      0u)
+      << result.message;
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kTube);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  ASSERT_EQ(gripper.opened_at.size(), 2u);  // the start, then over the bin
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
+  EXPECT_TRUE(planner.wrench_requests.empty());  // stopped before the analysis
+  EXPECT_FALSE(robot.Visited(testing::PlacePose()));
+  EXPECT_EQ(result.picks, 0u);
+
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "stopped");
+  EXPECT_EQ(a["stop"]["state"], "analyze");
+  EXPECT_EQ(a["stop"]["reason"], "operator stop (SIGINT)");
+  const json stop = Records("safe_stop").at(0);
+  EXPECT_EQ(stop["reason"], "stopped");
+  EXPECT_EQ(stop["device"], "operator");
+  EXPECT_EQ(stop["kind"], "stop");
+  EXPECT_EQ(stop["state"], "analyze");
+  EXPECT_EQ(stop["error"], "operator stop (SIGINT)");
+  EXPECT_EQ(stop["held"], "tube");
+  EXPECT_EQ(stop["action"], "released_in_bin");
+  const json end = Records("end").at(0);
+  EXPECT_EQ(end["reason"], "stopped");
+  EXPECT_EQ(end["message"], result.message);
+}
+
+TEST_F(CellControllerTest, StopAtTheScanStopsWithNothingHeld) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  observer = [this](CellState state) {
+    if (state == CellState::kScan) running->RequestStop("operator stop (SIGTERM)");
+  };
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kStopped);
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kNothing);
+  EXPECT_EQ(result.safe_stop->action, "stopped");
+  EXPECT_EQ(scanner.calls, 0);
+  EXPECT_TRUE(planner.plan_requests.empty());
+  EXPECT_EQ(gripper.opens, 1);
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
+  EXPECT_NE(
+      result.message.find("STOPPED: operator stop (SIGTERM) during scan; nothing held: stopped where it is"),
+      std::string::npos)
+      << result.message;
+  EXPECT_TRUE(Records("attempt").empty());
+  EXPECT_EQ(Records("safe_stop").at(0)["action"], "stopped");
+  EXPECT_EQ(Records("end").at(0)["reason"], "stopped");
+}
+
+TEST_F(CellControllerTest, StopFromAnotherThreadIsNoticedBeforeTheNextMotion) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  observer = [this](CellState state) {
+    if (state != CellState::kLift) return;
+    std::thread operator_thread([this] { running->RequestStop("stop button"); });
+    operator_thread.join();
+    EXPECT_TRUE(running->stop_requested());
+  };
+  // The lift state is entered, then the lift's MoveThrough would be the next motion: it is not made.
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kStopped) << result.message;
+  EXPECT_EQ(robot.throughs, 0);
+  EXPECT_EQ(Records("attempt").at(0)["stop"]["state"], "lift");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+}
+
+TEST_F(CellControllerTest, StopBeforeTheRunMovesNothingAndKeepsTheFirstReason) {
+  CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
+  EXPECT_FALSE(controller.stop_requested());
+  controller.RequestStop("stop button");
+  controller.RequestStop("operator stop (SIGINT)");
+  const CellRunResult result = controller.Run(1);
+  EXPECT_EQ(result.reason, CellStopReason::kStopped);
+  EXPECT_EQ(*result.operator_stop, "stop button");
+  EXPECT_FALSE(robot.servo_on);
+  EXPECT_TRUE(robot.moves.empty());
+  EXPECT_EQ(gripper.activations + gripper.opens + gripper.closes, 0);
+  EXPECT_NE(result.message.find(
+                "STOPPED: stop button during start; stopped before the cell started: nothing moved"),
+            std::string::npos)
+      << result.message;
+  // The controller stays stopped.
+  EXPECT_EQ(controller.Run(2).reason, CellStopReason::kStopped);
+  EXPECT_TRUE(robot.moves.empty());
+}
+
+// ---------------------------------------------------------------- dry run
+
+TEST_F(CellControllerTest, DryRunMovesNothingAndListsTheCommandsOfTheBestExecutablePlan) {
+  robot.forbid_motion = true;
+  gripper.forbid_motion = true;
+  planner.plan_answers.push_back(
+      Plans({InMillimetres(MakePlan(1, p_Bin_grasp)), MakePlan(4, p_Bin_grasp)}, 5));
+  const DryRunResult dry = DryRun();
+
+  EXPECT_EQ(dry.run.reason, CellStopReason::kDryRun) << dry.run.message;
+  EXPECT_EQ(dry.run.message,
+            "dry run: plan 1 (tube 4) of 2: 10 commands planned, nothing moved (1 plans skipped)");
+  ASSERT_TRUE(dry.plan_rank);
+  EXPECT_EQ(*dry.plan_rank, 1u);
+  EXPECT_EQ(dry.tube, 4u);
+  ASSERT_EQ(dry.skipped_plans.size(), 1u);
+  EXPECT_EQ(dry.skipped_plans[0]["check"], "cell_frame");
+  EXPECT_EQ(ft.biases, 0);
+  EXPECT_EQ(scanner.calls, 1);
+  ASSERT_TRUE(dry.X_BinTcpStart);
+  EXPECT_NEAR(dry.X_BinTcpStart->translation().z(), 1.0, kTol);
+
+  ASSERT_EQ(dry.motions.size(), 10u);
+  const Eigen::Isometry3d X_BinTcpPreGrasp =
+      DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, params.approach_height));
+  // First the approach: from home at transit height across, then down to the pre-grasp pose.
+  const PlannedMotion& approach = dry.motions[0];
+  EXPECT_EQ(approach.kind, MotionKind::kTransit);
+  EXPECT_EQ(approach.state, CellState::kApproach);
+  EXPECT_TRUE(approach.X_BinTcp.isApprox(X_BinTcpPreGrasp, kTol));
+  ASSERT_EQ(approach.via.size(), 1u);
+  EXPECT_NEAR(approach.via[0].translation().z(), TransitHeight(params, cell), kTol);
+  EXPECT_DOUBLE_EQ(approach.speed, params.transit_speed);
+  EXPECT_EQ(dry.motions[1].kind, MotionKind::kGripperMoveTo);
+  EXPECT_DOUBLE_EQ(*dry.motions[1].gripper_opening, 0.045);
+  EXPECT_EQ(dry.motions[2].kind, MotionKind::kMoveTo);
+  EXPECT_TRUE(dry.motions[2].X_BinTcp.isApprox(DownPose(p_Bin_grasp), kTol));
+  EXPECT_DOUBLE_EQ(dry.motions[2].speed, params.approach_speed);
+  EXPECT_EQ(dry.motions[3].kind, MotionKind::kGripperClose);
+  EXPECT_EQ(dry.motions[4].kind, MotionKind::kMoveThrough);
+  EXPECT_EQ(dry.motions[4].waypoints_Bin.size(), 2u);
+  EXPECT_TRUE(dry.motions[4].X_BinTcp.isApprox(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4)), kTol));
+  bool place = false;
+  for (const PlannedMotion& m : dry.motions)
+    if (m.kind == MotionKind::kMoveTo && m.X_BinTcp.isApprox(testing::PlacePose(), kTol)) place = true;
+  EXPECT_TRUE(place);
+  EXPECT_EQ(dry.motions[7].kind, MotionKind::kGripperOpen);
+  EXPECT_TRUE(dry.motions[7].X_BinTcp.isApprox(testing::PlacePose(), kTol));
+  EXPECT_TRUE(dry.motions.back().X_BinTcp.isApprox(HomePose(params, cell), kTol));
+
+  // Nothing moved (forbid_motion would have failed the test), and one record says what would.
+  EXPECT_TRUE(robot.moves.empty());
+  EXPECT_EQ(gripper.activations + gripper.opens + gripper.closes + gripper.moves, 0);
+  ASSERT_EQ(sink.records().size(), 1u);
+  const json& record = sink.records()[0];
+  EXPECT_EQ(record["type"], "dry_run");
+  EXPECT_EQ(record["reason"], "dry_run");
+  EXPECT_EQ(record["plan_rank"], 1);
+  EXPECT_EQ(record["motions"].size(), 10u);
+  EXPECT_EQ(record["motions"][0]["kind"], "transit");
+  EXPECT_NEAR(record["motions"][0]["tcp_pose"]["position"][2].get<double>(),
+              X_BinTcpPreGrasp.translation().z(), kTol);
+  EXPECT_EQ(record["motions"][1]["gripper_opening"], 0.045);
+  const std::string text = FormatDryRun(dry);
+  EXPECT_NE(text.find("approach  transit"), std::string::npos) << text;
+  EXPECT_NE(text.find("skipped plan 0 (tube 1): cell check:"), std::string::npos) << text;
+}
+
+TEST_F(CellControllerTest, DryRunListsExactlyTheRobotCommandsOfARun) {
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  const DryRunResult dry = DryRun();
+  ASSERT_FALSE(dry.motions.empty()) << dry.run.message;
+  ASSERT_TRUE(robot.moves.empty());
+  // The same plan, run: after the start's way home, the robot gets exactly the dry run's commands.
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  ASSERT_EQ(Run().picks, 1u);
+  std::vector<testing::ScriptedRobot::Move> expected;
+  for (const PlannedMotion& m : dry.motions) {
+    for (const Eigen::Isometry3d& X : m.via) expected.push_back({false, X, {}, m.speed});
+    if (m.kind == MotionKind::kTransit || m.kind == MotionKind::kMoveTo)
+      expected.push_back({false, m.X_BinTcp, {}, m.speed});
+    if (m.kind == MotionKind::kMoveThrough) expected.push_back({true, m.X_BinTcp, m.waypoints_Bin, m.speed});
+  }
+  ASSERT_GE(robot.moves.size(), expected.size());
+  const std::size_t start = robot.moves.size() - expected.size();
+  EXPECT_EQ(start, 2u);  // home from (0, 0, 1): across at 1 m, down to the home pose
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const testing::ScriptedRobot::Move& done = robot.moves[start + i];
+    EXPECT_EQ(done.through, expected[i].through) << i;
+    EXPECT_TRUE(done.X_BinTcpTarget.isApprox(expected[i].X_BinTcpTarget, kTol)) << i;
+    EXPECT_DOUBLE_EQ(done.speed, expected[i].speed) << i;
+    EXPECT_EQ(done.waypoints_Bin.size(), expected[i].waypoints_Bin.size()) << i;
+  }
+  EXPECT_EQ(gripper.openings, std::vector<double>{*dry.motions[1].gripper_opening});
+}
+
+TEST_F(CellControllerTest, DryRunOfAnEmptyBinOrWithoutAnExecutablePlanListsNothing) {
+  const DryRunResult empty = DryRun();
+  EXPECT_EQ(empty.run.reason, CellStopReason::kBinEmpty);
+  EXPECT_TRUE(empty.bin_empty);
+  EXPECT_TRUE(empty.motions.empty());
+
+  planner.plan_answers.push_back(Plans({InMillimetres(MakePlan(1, p_Bin_grasp))}, 1));
+  const DryRunResult mismatch = DryRun();
+  EXPECT_EQ(mismatch.run.reason, CellStopReason::kDryRun);
+  EXPECT_TRUE(mismatch.motions.empty());
+  EXPECT_FALSE(mismatch.plan_rank);
+  ASSERT_TRUE(mismatch.cell_mismatch);
+  EXPECT_NE(mismatch.run.message.find("no executable plan (1 plans, 1 tubes modeled): all 1 plans"),
+            std::string::npos)
+      << mismatch.run.message;
+  EXPECT_TRUE(robot.moves.empty());
+}
+
+TEST_F(CellControllerTest, DryRunFaultNeverMovesEvenWhenTheGripperHoldsSomething) {
+  robot.forbid_motion = true;
+  gripper.forbid_motion = true;
+  gripper.holding = true;  // left closed on a tube
+  const Failure timeout{true, "PhoXi: no frame within 30000 ms"};
+  scanner.failures = {timeout, timeout, timeout};
+  const DryRunResult dry = DryRun();
+  EXPECT_EQ(dry.run.reason, CellStopReason::kFault);
+  ASSERT_TRUE(dry.run.safe_stop);
+  EXPECT_EQ(dry.run.safe_stop->held, Held::kTube);
+  EXPECT_EQ(dry.run.safe_stop->action, "stopped");
+  EXPECT_NE(dry.run.message.find("dry run: nothing moved (the gripper holds tube)"), std::string::npos)
+      << dry.run.message;
+  EXPECT_TRUE(robot.moves.empty());
+  EXPECT_EQ(Records("dry_run").at(0)["reason"], "fault");
 }
 
 TEST(CellControllerParamsTest, InvalidValuesNameTheField) {

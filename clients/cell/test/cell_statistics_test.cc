@@ -30,6 +30,17 @@ json End(int round, const std::string& reason, int start, int left) {
           {"truth", {{"tubes_in_bin", left}}}};
 }
 
+TEST(CellStatisticsTest, OperatorStopsAreCountedApartFromFaults) {
+  json stopped = Attempt(0, 2, 2, "stopped");
+  const CellStatistics s = SummarizeRecords({stopped, End(0, "stopped", 2, 2), End(1, "fault", 2, 2)});
+  EXPECT_EQ(s.rounds, 2u);
+  EXPECT_EQ(s.operator_stops, 1u);
+  EXPECT_EQ(s.fault_stops, 1u);
+  EXPECT_EQ(s.attempts, 1u);
+  EXPECT_EQ(s.picks, 0u);
+  EXPECT_EQ(StatisticsJson(s)["operator_stops"], 1);
+}
+
 TEST(CellStatisticsTest, ReproducesTheThesisTablesFromRecords) {
   const std::vector<json> records = {
       // Round 0: 3 tubes. At 3: entangled pair returned, then picked on the second attempt

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
 #include "clients/cell/planner_client.h"
@@ -71,8 +72,11 @@ class ScriptedRobot final : public devices::Robot {
   /// An alarm on the first MoveTo whose target this returns true for (and every motion after it).
   std::function<bool(const Eigen::Isometry3d&)> alarm_on_move_to;
   int throughs = 0;
+  /// Every motion command (and servo on) fails the test: a dry run must not move.
+  bool forbid_motion = false;
 
   void MoveTo(const Eigen::Isometry3d& X_BinTcpTarget, double speed, devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Robot::MoveTo called";
     if (alarm_on_move_to && alarm_on_move_to(X_BinTcpTarget)) fail_always = true;
     if (fail_always) failure.Throw();
     moves.push_back({false, X_BinTcpTarget, {}, speed});
@@ -82,6 +86,7 @@ class ScriptedRobot final : public devices::Robot {
   devices::RobotLimits Limits() const override { return limits; }
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed,
                    devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Robot::MoveThrough called";
     const int i = throughs++;
     if (fail_always || (fail_through_from && i >= *fail_through_from)) {
       fail_always = true;  // a robot in alarm refuses every further motion
@@ -93,7 +98,10 @@ class ScriptedRobot final : public devices::Robot {
     X_BinTcp = X_BinTcpTarget;
   }
   Eigen::Isometry3d CurrentPose(devices::Timeout) override { return X_BinTcp; }
-  void ServoOn(devices::Timeout) override { servo_on = true; }
+  void ServoOn(devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Robot::ServoOn called";
+    servo_on = true;
+  }
 
   /// Whether some MoveTo / MoveThrough ended at `X_BinTcpVisited` (within 1e-9).
   bool Visited(const Eigen::Isometry3d& X_BinTcpVisited) const {
@@ -120,14 +128,21 @@ class ScriptedGripper final : public devices::Gripper {
   const Eigen::Isometry3d* tcp = nullptr;
   std::vector<Eigen::Vector3d> opened_at;
   std::vector<double> openings;
+  /// Every command that moves the fingers (and activation) fails the test: a dry run must not move.
+  bool forbid_motion = false;
 
-  void Activate(devices::Timeout) override { ++activations; }
+  void Activate(devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Gripper::Activate called";
+    ++activations;
+  }
   devices::GripperStatus MoveTo(double opening, double, double, devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Gripper::MoveTo called";
     ++moves;
     openings.push_back(opening);
     return Current();
   }
   devices::GripperStatus Open(devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Gripper::Open called";
     const int i = opens++;
     if (fail_open_from && i >= *fail_open_from) open_failure.Throw();
     open = true;
@@ -138,6 +153,7 @@ class ScriptedGripper final : public devices::Gripper {
     return s;
   }
   devices::GripperStatus Close(double, double, devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Gripper::Close called";
     ++closes;
     open = false;
     devices::GripperStatus s;
