@@ -4,6 +4,8 @@
 #include <CLI/CLI.hpp>
 
 #include "clients/cli/cell/cell_command.h"
+#include "clients/cli/cell/devices_check.h"
+#include "clients/cli/cell/virtual_cell.h"
 #include "clients/cli/eval/eval_command.h"
 #include "clients/cli/load/bench_service.h"
 #include "clients/cli/load/load_command.h"
@@ -29,6 +31,8 @@ int main(int argc, char** argv) {
   tubepick::cli::AddSceneCommand(app);
   tubepick::cli::AddEvalCommand(app);
   tubepick::cli::AddCellCommand(app);
+  tubepick::cli::AddDevicesCommand(app);
+  tubepick::cli::AddVirtualCellCommand(app);
   tubepick::cli::AddLoadCommand(app);
   tubepick::cli::AddHealthCommand(app);
   tubepick::cli::AddRequestCommand(app);

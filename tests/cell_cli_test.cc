@@ -95,10 +95,10 @@ TEST(CellCliTest, InjectedFaultRateOutsideZeroToOneIsRefused) {
       << run.output;
 }
 
-TEST(CellCliTest, WithoutSimItSaysWhy) {
+TEST(CellCliTest, WithoutSimOrDevicesItSaysWhichCellIsMissing) {
   const testing::CliRun run = RunCli("cell --rounds 1");
   EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_NE(run.output.find("--sim is required"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("which cell? --devices FILE for a real cell"), std::string::npos) << run.output;
 }
 
 void WriteText(const std::filesystem::path& path, const std::string& text) {

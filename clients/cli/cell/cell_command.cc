@@ -16,14 +16,17 @@
 #include "clients/cell/cell_records.h"
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
+#include "clients/cli/cell/cell_devices.h"
 #include "clients/cli/cell/cell_tables.h"
 #include "clients/cli/cell/fault_campaign.h"
 #include "clients/cli/cell/fault_injector.h"
+#include "clients/cli/cell/operator_stop.h"
 #include "clients/cli/cell/planner_outage.h"
 #include "clients/cli/cell/sim_round.h"
 #include "clients/cli/remote/server_process.h"
 #include "core/common/cell_config.h"
 #include "core/common/errors.h"
+#include "devices/devices_config.h"
 #include "devices/sim/sim_cell.h"
 
 namespace tubepick::cli {
@@ -50,6 +53,10 @@ struct CellOptions {
   std::string cell_path;    ///< empty = the thesis cell for --material
   double fault_rate = 0.0;  ///< --inject-faults
   std::uint64_t fault_seed = 1;
+  std::string devices_path;  ///< --devices: the real (or mixed) cell
+  bool print_devices_config = false;
+  bool dry_run = false;
+  cell::GrpcPlannerClientOptions planner_options;  ///< --tls-*
   // Options given on the command line (they override --controller).
   bool profile_given = false;
   bool resolution_given = false;
@@ -88,6 +95,127 @@ cell::CellControllerParams ControllerParams(const CellOptions& o) {
   return params;
 }
 
+/// The planner of the run: `--server auto` starts tubepick-server (its own process group, dies
+/// with this process), else the address given.
+std::unique_ptr<RestartableServer> StartPlanner(const CellOptions& o, std::string& address) {
+  address = o.server;
+  if (o.server != "auto") {
+    fmt::print("planner: {}\n", address);
+    return nullptr;
+  }
+  auto server = std::make_unique<RestartableServer>(
+      SiblingExecutable("tubepick-server"),
+      std::vector<std::string>{"--metrics-address", "", "--log-level", "info"});
+  address = server->address();
+  fmt::print("planner: started tubepick-server (pid {}) on {}\n", server->pid(), address);
+  return server;
+}
+
+void StopPlanner(RestartableServer* server) {
+  if (!server) return;
+  const int status = server->Stop(std::chrono::seconds(15));
+  spdlog::info("tubepick-server exited with status {}", status);
+}
+
+void WriteJson(const std::string& path, const json& document) {
+  if (path.empty()) return;
+  std::ofstream out(path);
+  if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", path));
+  out << document.dump(2) << '\n';
+  fmt::print("wrote {}\n", path);
+}
+
+/// Exit status after an operator stop: 128 + the signal, as a shell reports a killed command.
+[[noreturn]] void ExitForSignal(const OperatorStop& stop) {
+  fmt::print("stopped by {}: the round ended in the safe stop\n", stop.SignalName());
+  std::fflush(stdout);
+  throw CLI::RuntimeError(128 + stop.signal());
+}
+
+json RoundJson(std::uint32_t round, const cell::CellRunResult& result, double wall) {
+  return {{"round", round},
+          {"reason", cell::ToString(result.reason)},
+          {"message", result.message},
+          {"picks", result.picks},
+          {"lost_in_transit", result.lost},
+          {"attempts", result.attempts},
+          {"scans", result.scans},
+          {"wall_s", wall}};
+}
+
+/// Rounds on the devices of a devices file (tubepick cell --devices FILE): the same controller,
+/// limits, records and tables as in the simulated cell; device time is wall time.
+void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_params) {
+  const devices::DevicesConfig config = devices::LoadDevicesConfig(o.devices_path);
+  if (o.fault_rate > 0.0)
+    throw InvalidArgument("--inject-faults: only with --sim (faults are injected into the simulated cell)");
+  OpenedCell opened = OpenCell(config, o.cell_path);
+  fmt::print("devices: robot {}, gripper {}, F/T {}, scanner {}; cell from {}\n",
+             devices::ToString(config.robot_driver), devices::ToString(config.gripper_driver),
+             devices::ToString(config.ft_driver), devices::ToString(config.scanner_driver),
+             opened.cell_source);
+  OperatorStop stop;
+  std::string address;
+  std::unique_ptr<RestartableServer> server = StartPlanner(o, address);
+  cell::GrpcPlannerClient planner(address, o.planner_options);
+
+  cell::MemoryRecordSink memory;
+  std::unique_ptr<cell::JsonLinesFileSink> file;
+  if (!o.records_path.empty()) file = std::make_unique<cell::JsonLinesFileSink>(o.records_path);
+  cell::TeeRecordSink sink(&memory, file.get());
+
+  if (o.dry_run) {
+    cell::CellControllerParams params = base_params;
+    params.seed = o.seed * 1000;
+    cell::CellController controller(opened.devices, planner, opened.cell, params, &sink);
+    const cell::DryRunResult dry = controller.DryRun(0);
+    fmt::print("{}", cell::FormatDryRun(dry));
+    WriteJson(o.json_path, cell::DryRunJson(dry));
+    StopPlanner(server.get());
+    if (!dry.motions.empty() || dry.bin_empty) return;
+    throw CLI::RuntimeError(3);
+  }
+
+  json rounds_json = json::array();
+  bool any_fault = false;
+  for (std::uint32_t round = 0; round < o.rounds && stop.signal() == 0; ++round) {
+    cell::CellControllerParams params = base_params;
+    params.seed = (o.seed + round) * 1000;
+    const auto round_start = std::chrono::steady_clock::now();
+    cell::CellController controller(opened.devices, planner, opened.cell, params, &sink);
+    const auto wall_start = std::chrono::steady_clock::now();
+    controller.set_device_clock([wall_start] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    });
+    cell::CellRunResult result;
+    {
+      OperatorStop::Watch watch(stop, controller);
+      result = controller.Run(round);
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
+    fmt::print("round {:>2}: {} | {} picked, {} lost in transit, {} attempts, {} scans, {:.0f} s\n", round,
+               result.message, result.picks, result.lost, result.attempts, result.scans, wall);
+    std::fflush(stdout);
+    rounds_json.push_back(RoundJson(round, result, wall));
+    if (result.reason != cell::CellStopReason::kBinEmpty &&
+        result.reason != cell::CellStopReason::kLimitReached) {
+      any_fault = true;
+      break;  // a real cell does not carry on after a safe stop: the operator looks first
+    }
+  }
+  const cell::CellStatistics stats = cell::SummarizeRecords(memory.records());
+  fmt::print("\n{}", FormatCellTables(stats, fmt::format("{}, {} round{}", o.devices_path, stats.rounds,
+                                                         stats.rounds == 1 ? "" : "s")));
+  if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  WriteJson(o.json_path, json{{"devices", o.devices_path},
+                              {"seed", o.seed},
+                              {"rounds", rounds_json},
+                              {"statistics", cell::StatisticsJson(stats)}});
+  StopPlanner(server.get());
+  if (stop.signal() != 0) ExitForSignal(stop);
+  if (any_fault) throw CLI::RuntimeError(3);
+}
+
 void Run(const CellOptions& o) {
   const cell::CellControllerParams base_params = ControllerParams(o);
   if (o.print_controller_config) {
@@ -96,10 +224,19 @@ void Run(const CellOptions& o) {
   }
   const bool custom_cell = !o.cell_path.empty();
   const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
-  if (!o.sim)
+  if (o.print_devices_config) {
+    fmt::print("{}", devices::ExampleDevicesConfig());
+    return;
+  }
+  if (o.sim && !o.devices_path.empty())
+    throw InvalidArgument("--sim and --devices: give one (--sim is the all-simulated cell)");
+  if (!o.sim && o.devices_path.empty())
     throw InvalidArgument(
-        "--sim is required: the cell command drives the simulated cell (the real drivers "
-        "in devices/ are not wired to this command yet)");
+        "which cell? --devices FILE for a real cell (tubepick cell --print-devices-config prints an example; "
+        "`tubepick devices check --devices FILE` first), or --sim for the simulated cell");
+  if (!o.devices_path.empty()) return RunOnDevices(o, base_params);
+  if (o.dry_run)
+    throw InvalidArgument("--dry-run: with --devices FILE (the simulated cell has nothing to spare)");
   if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
   if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
   const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
@@ -109,21 +246,13 @@ void Run(const CellOptions& o) {
         fmt::format("--inject-faults: a probability per state in [0, 1], got {}", o.fault_rate));
   const bool injecting = o.fault_rate > 0.0;
 
-  std::unique_ptr<RestartableServer> server;
-  std::string address = o.server;
-  if (o.server == "auto") {
-    server = std::make_unique<RestartableServer>(
-        SiblingExecutable("tubepick-server"),
-        std::vector<std::string>{"--metrics-address", "", "--log-level", "info"});
-    address = server->address();
-    fmt::print("planner: started tubepick-server (pid {}) on {}\n", server->pid(), address);
-  } else {
-    fmt::print("planner: {}\n", address);
-    if (injecting)
-      fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
-  }
+  OperatorStop stop;
+  std::string address;
+  std::unique_ptr<RestartableServer> server = StartPlanner(o, address);
+  if (!server && injecting)
+    fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
   FaultCampaign campaign;
-  cell::GrpcPlannerClient planner(address);
+  cell::GrpcPlannerClient planner(address, o.planner_options);
 
   cell::MemoryRecordSink memory;
   std::unique_ptr<cell::JsonLinesFileSink> file;
@@ -132,7 +261,7 @@ void Run(const CellOptions& o) {
 
   json rounds_json = json::array();
   bool any_fault = false;
-  for (std::uint32_t round = 0; round < o.rounds; ++round) {
+  for (std::uint32_t round = 0; round < o.rounds && stop.signal() == 0; ++round) {
     cell::CellControllerParams params = base_params;
     params.seed = (o.seed + round) * 1000;
     devices::sim::SimCellParams sim_params =
@@ -150,7 +279,7 @@ void Run(const CellOptions& o) {
       injector.emplace(o.fault_rate, o.fault_seed * 1000 + round, sim, server.get());
       observer = [&injector](cell::CellState state) { injector->OnState(state); };
     }
-    const SimRoundResult r = RunSimRound(planner, sim, params, round, &sink, observer);
+    const SimRoundResult r = RunSimRound(planner, sim, params, round, &sink, observer, &stop);
     campaign.Add(r, injector ? &*injector : nullptr);
     const cell::CellRunResult& result = r.run;
     const std::uint32_t left = r.tubes_in_bin;
@@ -189,23 +318,14 @@ void Run(const CellOptions& o) {
                                             stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
   if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
   if (injecting) fmt::print("{}\n{}\n", campaign.KindsLine(), campaign.SummaryLine());
-  if (!o.json_path.empty()) {
-    std::ofstream out(o.json_path);
-    if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", o.json_path));
-    out << json{{"material", o.material},
-                {"tubes", o.tubes},
-                {"seed", o.seed},
-                {"rounds", rounds_json},
-                {"faults", campaign.Json(o.fault_rate, o.fault_seed)},
-                {"statistics", cell::StatisticsJson(stats)}}
-               .dump(2)
-        << '\n';
-    fmt::print("wrote {}\n", o.json_path);
-  }
-  if (server) {
-    const int status = server->Stop(std::chrono::seconds(15));
-    spdlog::info("tubepick-server exited with status {}", status);
-  }
+  WriteJson(o.json_path, json{{"material", o.material},
+                              {"tubes", o.tubes},
+                              {"seed", o.seed},
+                              {"rounds", rounds_json},
+                              {"faults", campaign.Json(o.fault_rate, o.fault_seed)},
+                              {"statistics", cell::StatisticsJson(stats)}});
+  StopPlanner(server.get());
+  if (stop.signal() != 0) ExitForSignal(stop);
   // A campaign expects safe stops; what it must never see is a tube released outside.
   if (injecting ? campaign.released_outside > 0 : any_fault) throw CLI::RuntimeError(3);
 }
@@ -214,9 +334,28 @@ void Run(const CellOptions& o) {
 
 void AddCellCommand(CLI::App& app) {
   auto o = std::make_shared<CellOptions>();
-  CLI::App* cmd =
-      app.add_subcommand("cell", "Run bin-picking rounds in the simulated cell (thesis Tables 5.4-5.9)");
+  CLI::App* cmd = app.add_subcommand(
+      "cell",
+      "Run bin-picking rounds on a cell's devices (--devices) or in the simulated cell (--sim); "
+      "thesis Tables 5.4-5.9");
   cmd->add_flag("--sim", o->sim, "Use the simulated cell (Bullet world behind all four devices)");
+  cmd->add_option("--devices", o->devices_path,
+                  "Devices YAML of a real (or virtual) cell: a driver and connection per device "
+                  "(--print-devices-config prints an example; check it with `tubepick devices check`)")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--print-devices-config", o->print_devices_config,
+                "Print a commented example devices YAML and exit");
+  cmd->add_flag("--dry-run", o->dry_run,
+                "With --devices: scan and plan once, print the motions the cell would command, move nothing");
+  cmd->add_option("--tls-ca", o->planner_options.tls_ca_file,
+                  "PEM CA bundle of the planner's certificate (enables TLS)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-cert", o->planner_options.tls_cert_file, "PEM client certificate chain (mutual TLS)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-key", o->planner_options.tls_key_file, "PEM client private key (mutual TLS)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-server-name", o->planner_options.tls_server_name,
+                  "Name to check the planner's certificate against (default: the address' host)");
   cmd->add_option("--rounds", o->rounds, "Rounds (bins) to run; round r uses seed + r")
       ->capture_default_str();
   cmd->add_option("--tubes", o->tubes, "Tubes dropped into the bin per round")->capture_default_str();

@@ -1,6 +1,7 @@
 #include "clients/cli/cell/sim_round.h"
 
 #include <chrono>
+#include <optional>
 
 namespace tubepick::cli {
 namespace {
@@ -21,7 +22,8 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::Sim
 
 SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& sim,
                            const cell::CellControllerParams& params, std::uint32_t round,
-                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer) {
+                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer,
+                           OperatorStop* stop) {
   const auto wall_start = std::chrono::steady_clock::now();
   cell::CellController controller({&sim.scanner(), &sim.robot(), &sim.gripper(), &sim.ft_sensor()}, planner,
                                   sim.cell(), params, sink);
@@ -35,7 +37,11 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& 
   });
   if (observer) controller.set_state_observer(std::move(observer));
   SimRoundResult result;
-  result.run = controller.Run(round);
+  {
+    std::optional<OperatorStop::Watch> watch;
+    if (stop) watch.emplace(*stop, controller);
+    result.run = controller.Run(round);
+  }
   sim.Advance(kRestAfterRound);  // what fell comes to rest before it is counted
   result.tubes_in_bin = sim.TubesInBin();
   result.tubes_outside_bin = sim.TubesOutsideBin();

@@ -6,6 +6,7 @@
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
 #include "clients/cell/planner_client.h"
+#include "clients/cli/cell/operator_stop.h"
 #include "devices/sim/sim_cell.h"
 
 namespace tubepick::cli {
@@ -36,9 +37,11 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::Sim
                            cell::RecordSink* sink);
 
 /// The same on a cell built by the caller (e.g. with explicit tubes: SimCell(params, tubes_Bin));
-/// wall_s then covers only the run. `observer` (if set) sees every state the controller enters.
+/// wall_s then covers only the run. `observer` (if set) sees every state the controller enters;
+/// `stop` (if set) stops the round on SIGINT / SIGTERM.
 SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& sim,
                            const cell::CellControllerParams& params, std::uint32_t round,
-                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer = {});
+                           cell::RecordSink* sink, std::function<void(cell::CellState)> observer = {},
+                           OperatorStop* stop = nullptr);
 
 }  // namespace tubepick::cli

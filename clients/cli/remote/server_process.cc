@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -52,9 +53,20 @@ std::unique_ptr<ServerProcess> ServerProcess::Start(const std::string& binary,
   for (std::string& a : argv_strings) argv.push_back(a.data());
   argv.push_back(nullptr);
 
+  const pid_t parent = ::getpid();
+  // PR_SET_PDEATHSIG follows the thread that forked: only a child of the main thread (which lives
+  // as long as the process) can die with its parent; a fault campaign's restart thread cannot.
+  const bool die_with_parent = ::gettid() == parent;
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(fmt::format("fork: {}", std::strerror(errno)));
   if (pid == 0) {  // child: stdout and stderr into the pipe, then exec
+    // Its own process group: a Ctrl-C at the terminal reaches the parent only, which stops the
+    // round safely and then this server. And it dies with the parent (SIGTERM: it drains).
+    ::setpgid(0, 0);
+    if (die_with_parent) {
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (::getppid() != parent) ::_exit(0);  // the parent died before prctl
+    }
     ::dup2(fds[1], STDOUT_FILENO);
     ::dup2(fds[1], STDERR_FILENO);
     ::execv(binary.c_str(), argv.data());
