@@ -142,11 +142,7 @@ Capture ExecScanner::Scan(Timeout timeout) {
     throw DeviceFault(fmt::format("exec scanner: the file '{}' wrote is not a cloud: {}", command, e.what()));
   }
   fs::remove(out, ec);
-  Capture capture;
-  capture.points_Sensor = std::move(cloud.points);
-  capture.unit = params_.sensor.unit;
-  capture.X_BinSensor = params_.sensor.X_BinSensor;
-  return capture;
+  return CaptureOf(std::move(cloud.points), params_.sensor);
 }
 
 }  // namespace tubepick::devices

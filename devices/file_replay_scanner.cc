@@ -103,11 +103,7 @@ Capture FileReplayScanner::Scan(Timeout /*timeout*/) {
   } catch (const std::exception& e) {
     throw DeviceFault("file replay scanner: cannot read " + current_file_ + ": " + e.what());
   }
-  Capture capture;
-  capture.points_Sensor = std::move(cloud.points);
-  capture.unit = params_.sensor.unit;
-  capture.X_BinSensor = params_.sensor.X_BinSensor;
-  return capture;
+  return CaptureOf(std::move(cloud.points), params_.sensor);
 }
 
 }  // namespace tubepick::devices

@@ -249,6 +249,7 @@ TEST(CellOperatorStopTest, SigintDuringARoundEndsInTheSafeStopAndExit130) {
   EXPECT_EQ(cli.Wait(60s), 130) << cli.Output();
   const std::string out = cli.Output();
   EXPECT_NE(out.find("stopped by SIGINT"), std::string::npos) << out;
+  EXPECT_NE(out.find("0 fault, 1 operator"), std::string::npos) << "the tables count the stop:\n" << out;
   // The stopped round is the last one: the remaining rounds are skipped.
   const std::regex round_line("round +\\d+ \\(seed \\d+\\): ([^|]*)");
   std::vector<std::string> rounds;

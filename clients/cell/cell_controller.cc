@@ -144,6 +144,7 @@ void CellController::RequestStop(std::string why) {
     stop_why_ = why.empty() ? "operator stop" : std::move(why);
   }
   stop_requested_.store(true, std::memory_order_release);
+  planner_.CancelCalls();  // a PlanPick may run for minutes: the stop does not wait for it
 }
 
 void CellController::CheckStop() {

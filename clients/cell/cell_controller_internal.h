@@ -1,5 +1,7 @@
 #pragma once
 
+#include <spdlog/spdlog.h>
+
 // What the controller's source files share (cell_controller.cc, cell_attempt.cc,
 // cell_device_calls.cc): the state of a run, a scan and an attempt, and the device and planner call
 // wrappers that turn failures into CellFault. Not for use outside the controller.
@@ -128,6 +130,13 @@ std::optional<CellController::StopCause> CellController::Guarded(Body&& body) {
       throw CellFault("controller", FaultKind::kInternal, ToString(state_), e.what());
     }
   } catch (const CellFault& fault) {
+    // The planner call the stop cancelled (CancelCalls) ends in a planner fault: it is the stop.
+    if (fault.device() == "planner" && stop_requested()) {
+      std::lock_guard<std::mutex> lock(stop_mutex_);
+      stopping_ = true;
+      spdlog::warn("cell: {} during {} (the planner call was cancelled)", stop_why_, fault.state());
+      return StopCause{std::nullopt, stop_why_, fault.state()};
+    }
     return StopCause{fault, "", fault.state()};
   } catch (const StopRequested& stop) {
     return StopCause{std::nullopt, stop.why, stop.state};

@@ -3,6 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <set>
 #include <thread>
 
 #include "clients/cell/client_credentials.h"
@@ -53,6 +57,57 @@ struct GrpcPlannerClient::Impl {
   std::shared_ptr<grpc::Channel> channel;
   std::unique_ptr<v1::PickPlannerService::Stub> stub;
 
+  // Cancellation (CancelCalls): the contexts of the RPCs in flight, and a count of the cancels so
+  // far; a call started before the last cancel ends with CANCELLED.
+  std::mutex mutex;
+  std::condition_variable cancelled;
+  std::set<grpc::ClientContext*> in_flight;
+  std::uint64_t cancels = 0;
+
+  std::uint64_t Cancels() {
+    std::lock_guard lock(mutex);
+    return cancels;
+  }
+
+  [[noreturn]] static void ThrowCancelled(const char* rpc, std::uint32_t attempt) {
+    throw PlannerError(rpc, grpc::StatusCode::CANCELLED, "cancelled: the run is stopping", attempt);
+  }
+
+  /// Runs one try with `context` registered for CancelCalls; false when a cancel came first.
+  template <typename Response, typename Call>
+  bool TryCall(std::uint64_t generation, grpc::ClientContext& context, Call& call, Response& response,
+               grpc::Status& status) {
+    {
+      std::lock_guard lock(mutex);
+      if (cancels != generation) return false;
+      in_flight.insert(&context);
+    }
+    status = call(&context, &response);
+    std::lock_guard lock(mutex);
+    in_flight.erase(&context);
+    return cancels == generation || status.ok();
+  }
+
+  /// Waits for the channel to connect within `left`, in short slices so that a cancel ends it.
+  bool WaitForConnection(std::uint64_t generation, Clock::duration left) {
+    const Clock::time_point end = Clock::now() + left;
+    for (;;) {
+      if (Cancels() != generation) return false;
+      const Clock::duration slice =
+          std::min<Clock::duration>(end - Clock::now(), std::chrono::milliseconds(100));
+      if (slice <= Clock::duration::zero()) return false;
+      if (channel->WaitForConnected(std::chrono::system_clock::now() +
+                                    std::chrono::duration_cast<std::chrono::system_clock::duration>(slice)))
+        return true;
+    }
+  }
+
+  /// Sleeps `backoff`; false when a cancel ended it.
+  bool Backoff(std::uint64_t generation, std::chrono::milliseconds backoff) {
+    std::unique_lock lock(mutex);
+    return !cancelled.wait_for(lock, backoff, [&] { return cancels != generation; });
+  }
+
   /// Why a connection to the planner may fail, for the error message: the likely cause the
   /// configuration suggests.
   std::string ConnectionHint(const std::string& grpc_message) const {
@@ -92,22 +147,23 @@ struct GrpcPlannerClient::Impl {
     Clock::duration unavailable{0};
     std::chrono::milliseconds backoff = options.initial_backoff;
     std::uint32_t retries = 0;
+    const std::uint64_t generation = Cancels();
     for (std::uint32_t attempt = 1;; ++attempt) {
       if (channel->GetState(true) != GRPC_CHANNEL_READY) {
         const Clock::time_point wait_start = Clock::now();
         const Clock::duration left = budget - unavailable;
-        const bool connected =
-            left > Clock::duration::zero() &&
-            channel->WaitForConnected(std::chrono::system_clock::now() +
-                                      std::chrono::duration_cast<std::chrono::system_clock::duration>(left));
+        const bool connected = left > Clock::duration::zero() && WaitForConnection(generation, left);
         unavailable += Clock::now() - wait_start;
-        if (!connected) return LastTry<Response>(rpc, deadline, call, attempt, unavailable, budget_name);
+        if (Cancels() != generation) ThrowCancelled(rpc, attempt);
+        if (!connected)
+          return LastTry<Response>(rpc, deadline, call, attempt, unavailable, budget_name, generation);
       }
       grpc::ClientContext context;
       context.set_wait_for_ready(true);  // a connection lost just now is waited for, not failed
       context.set_deadline(std::chrono::system_clock::now() + deadline);
       Response response;
-      const grpc::Status status = call(&context, &response);
+      grpc::Status status;
+      if (!TryCall(generation, context, call, response, status)) ThrowCancelled(rpc, attempt);
       if (status.ok()) return response;
       if (!Retryable(status.error_code()))
         throw PlannerError(rpc, status.error_code(), Describe(status), attempt);
@@ -124,7 +180,7 @@ struct GrpcPlannerClient::Impl {
       spdlog::warn("{}: {} ({}), retry {} in {} ms ({:.1f} of {:.1f} s of {} spent)", rpc,
                    StatusCodeName(status.error_code()), status.error_message(), retries, backoff.count(),
                    Seconds(unavailable), Seconds(budget), budget_name);
-      std::this_thread::sleep_for(backoff);
+      if (!Backoff(generation, backoff)) ThrowCancelled(rpc, attempt);
       unavailable += backoff;
       backoff = std::min(backoff * 2, options.max_backoff);
     }
@@ -135,12 +191,13 @@ struct GrpcPlannerClient::Impl {
   /// call if the planner came back in the meantime.
   template <typename Response, typename Call>
   Response LastTry(const char* rpc, std::chrono::milliseconds deadline, Call call, std::uint32_t attempt,
-                   Clock::duration unavailable, const char* budget_name) {
+                   Clock::duration unavailable, const char* budget_name, std::uint64_t generation) {
     grpc::ClientContext context;
     context.set_wait_for_ready(false);
     context.set_deadline(std::chrono::system_clock::now() + deadline);
     Response response;
-    const grpc::Status status = call(&context, &response);
+    grpc::Status status;
+    if (!TryCall(generation, context, call, response, status)) ThrowCancelled(rpc, attempt);
     if (status.ok()) return response;
     const grpc::StatusCode code =
         Retryable(status.error_code()) ? grpc::StatusCode::UNAVAILABLE : status.error_code();
@@ -185,6 +242,13 @@ GrpcPlannerClient::GrpcPlannerClient(const std::string& address, GrpcPlannerClie
 }
 
 GrpcPlannerClient::~GrpcPlannerClient() = default;
+
+void GrpcPlannerClient::CancelCalls() {
+  std::lock_guard lock(impl_->mutex);
+  ++impl_->cancels;
+  for (grpc::ClientContext* context : impl_->in_flight) context->TryCancel();
+  impl_->cancelled.notify_all();
+}
 
 bool GrpcPlannerClient::tls() const {
   return !impl_->options.tls_ca_file.empty() || !impl_->options.tls_cert_file.empty();

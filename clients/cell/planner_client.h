@@ -47,6 +47,9 @@ class PlannerClient {
   /// @param deadline time allowed for one try. @throws PlannerError.
   virtual v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
                                                   std::chrono::milliseconds deadline) = 0;
+  /// Ends the calls under way at once (from any thread; an operator stop): they throw
+  /// PlannerError(CANCELLED). Calls started afterwards run normally. Default: nothing to cancel.
+  virtual void CancelCalls() {}
 };
 
 /// How GrpcPlannerClient connects, waits and retries.
@@ -104,6 +107,9 @@ class GrpcPlannerClient final : public PlannerClient {
                                 std::chrono::milliseconds deadline) override;
   v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
                                           std::chrono::milliseconds deadline) override;
+  /// Cancels the RPCs in flight (ClientContext::TryCancel) and ends the waits for a connection and
+  /// the backoffs of the calls under way.
+  void CancelCalls() override;
 
   const std::string& address() const { return address_; }
   /// Whether the channel uses TLS.

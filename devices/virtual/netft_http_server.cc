@@ -43,8 +43,7 @@ NetFtHttpServer::NetFtHttpServer(const std::string& host, std::uint16_t port, Ne
   if (fd_ >= 0) ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
   socklen_t length = sizeof address;
   if (fd_ < 0 || ::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
-      ::listen(fd_, 8) != 0 || ::getsockname(fd_, reinterpret_cast<sockaddr*>(&address), &length) != 0 ||
-      ::pipe2(wake_, O_CLOEXEC) != 0) {
+      ::listen(fd_, 8) != 0 || ::getsockname(fd_, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
     const std::string why = std::strerror(errno);
     if (fd_ >= 0) ::close(fd_);
     throw std::runtime_error(fmt::format("Net F/T web server {}:{}: {}", host, port, why));
@@ -54,22 +53,14 @@ NetFtHttpServer::NetFtHttpServer(const std::string& host, std::uint16_t port, Ne
 }
 
 NetFtHttpServer::~NetFtHttpServer() {
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
+  wake_.Wake();
   thread_.join();
   ::close(fd_);
-  ::close(wake_[0]);
-  ::close(wake_[1]);
 }
 
 void NetFtHttpServer::Run() {
   for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
-      return;
-    }
-    if (fds[1].revents != 0) return;
+    if (wake_.Wait(fd_) != WakePipe::Event::kReadable) return;
     const int client = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
     if (client < 0) continue;
     const std::string line = ReadRequestLine(client);

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "devices/netft_calibration.h"
+#include "devices/virtual/wake_pipe.h"
 
 namespace tubepick::devices {
 
@@ -26,7 +27,7 @@ class NetFtHttpServer {
 
   NetFtCalibration calibration_;
   int fd_ = -1;
-  int wake_[2] = {-1, -1};
+  WakePipe wake_{"Net F/T web server"};
   std::uint16_t port_ = 0;
   std::thread thread_;
 };

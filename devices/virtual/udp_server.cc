@@ -37,7 +37,7 @@ std::string UdpPeer::ToString() const {
 }
 
 UdpServer::UdpServer(std::string who, const std::string& host, std::uint16_t port, Handler handle)
-    : who_(std::move(who)), handle_(std::move(handle)) {
+    : who_(std::move(who)), handle_(std::move(handle)), wake_(who_) {
   addrinfo hints{};
   hints.ai_family = AF_INET;
   hints.ai_socktype = SOCK_DGRAM;
@@ -54,8 +54,6 @@ UdpServer::UdpServer(std::string who, const std::string& host, std::uint16_t por
   const auto fail = [this](const std::string& what) {
     const std::runtime_error error(who_ + ": " + what + ": " + std::strerror(errno));
     if (fd_ >= 0) ::close(fd_);
-    if (wake_[0] >= 0) ::close(wake_[0]);
-    if (wake_[1] >= 0) ::close(wake_[1]);
     return error;
   };
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
@@ -65,7 +63,6 @@ UdpServer::UdpServer(std::string who, const std::string& host, std::uint16_t por
   }
   socklen_t len = sizeof addr;
   if (::getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len) != 0) throw fail("getsockname");
-  if (::pipe2(wake_, O_CLOEXEC) != 0) throw fail("pipe");
   char text[INET_ADDRSTRLEN] = {};
   ::inet_ntop(AF_INET, &addr.sin_addr, text, sizeof text);
   host_ = text;
@@ -76,14 +73,11 @@ UdpServer::UdpServer(std::string who, const std::string& host, std::uint16_t por
 UdpServer::~UdpServer() {
   Stop();
   ::close(fd_);
-  ::close(wake_[0]);
-  ::close(wake_[1]);
 }
 
 void UdpServer::Stop() {
   if (!thread_.joinable()) return;
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
+  wake_.Wake();
   thread_.join();
 }
 
@@ -97,14 +91,10 @@ void UdpServer::SendTo(const UdpPeer& to, std::span<const std::uint8_t> bytes) {
 
 void UdpServer::Run() {
   for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
+    const WakePipe::Event event = wake_.Wait(fd_);
+    if (event == WakePipe::Event::kError)
       spdlog::error("{}: poll failed: {}; the server stops", who_, std::strerror(errno));
-      return;
-    }
-    if (fds[1].revents != 0) return;
-    if ((fds[0].revents & POLLIN) == 0) continue;
+    if (event != WakePipe::Event::kReadable) return;
     std::uint8_t buf[2048];
     sockaddr_in addr{};
     socklen_t addr_len = sizeof addr;

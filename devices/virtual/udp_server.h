@@ -7,6 +7,8 @@
 #include <thread>
 #include <vector>
 
+#include "devices/virtual/wake_pipe.h"
+
 namespace tubepick::devices {
 
 /// Where a datagram came from (IPv4, host byte order).
@@ -52,7 +54,7 @@ class UdpServer {
   Handler handle_;
   std::string host_;
   int fd_ = -1;
-  int wake_[2] = {-1, -1};  // pipe: Stop() writes to wake the thread
+  WakePipe wake_;  // Stop() wakes the thread
   std::uint16_t port_ = 0;
   std::thread thread_;
 };

@@ -1055,6 +1055,26 @@ TEST_F(CellControllerTest, StopFromAnotherThreadIsNoticedBeforeTheNextMotion) {
   EXPECT_EQ(result.safe_stop->action, "released_in_bin");
 }
 
+TEST_F(CellControllerTest, AStopDuringALongPlanCancelsItAndDoesNotWaitForIt) {
+  planner.block_plans = true;  // PlanPick would run until cancelled
+  std::thread operator_thread;
+  observer = [this, &operator_thread](CellState state) {
+    if (state != CellState::kPlan || operator_thread.joinable()) return;
+    operator_thread = std::thread([this] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      running->RequestStop("operator stop (SIGINT)");
+    });
+  };
+  const CellRunResult result = Run();
+  operator_thread.join();
+  EXPECT_EQ(planner.cancels.load(), 1) << "RequestStop cancelled the planner call";
+  EXPECT_EQ(result.reason, CellStopReason::kStopped) << result.message;
+  EXPECT_NE(result.message.find("STOPPED: operator stop (SIGINT) during plan"), std::string::npos)
+      << result.message;
+  EXPECT_FALSE(result.fault) << "the cancelled call is the stop, not a planner fault";
+  EXPECT_EQ(Records("end").at(0)["reason"], "stopped");
+}
+
 TEST_F(CellControllerTest, StopBeforeTheRunMovesNothingAndKeepsTheFirstReason) {
   CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
   EXPECT_FALSE(controller.stop_requested());

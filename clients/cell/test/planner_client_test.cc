@@ -208,6 +208,49 @@ TEST_F(PlannerClientTest, UnavailableAnswersAreRetriedWithinTheBudget) {
   EXPECT_EQ(service_.calls, 5);
 }
 
+/// Calls `call` on another thread, cancels after `after`; returns how long the call ran and its error.
+template <typename Call>
+std::pair<std::chrono::steady_clock::duration, std::optional<PlannerError>> CancelledAfter(
+    GrpcPlannerClient& client, std::chrono::milliseconds after, Call call) {
+  std::optional<PlannerError> error;
+  std::chrono::steady_clock::duration took{};
+  std::thread caller([&] {
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      call();
+    } catch (const PlannerError& e) {
+      error = e;
+    }
+    took = std::chrono::steady_clock::now() - start;
+  });
+  std::this_thread::sleep_for(after);
+  client.CancelCalls();
+  caller.join();
+  return {took, error};
+}
+
+TEST_F(PlannerClientTest, CancelCallsEndsAPlanPickInFlightAndLaterCallsRun) {
+  service_.delay = std::chrono::milliseconds(2000);  // a long plan
+  GrpcPlannerClient client(address(), options_);
+  const auto [took, error] =
+      CancelledAfter(client, std::chrono::milliseconds(300), [&] { client.PlanPick(Request(), kDeadline); });
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->code(), grpc::StatusCode::CANCELLED) << error->what();
+  EXPECT_LT(took, std::chrono::milliseconds(1500)) << "the call did not wait for the plan";
+  service_.delay = std::chrono::milliseconds(0);
+  EXPECT_EQ(client.PlanPick(Request(), kDeadline).total_seconds(), 7) << "a call after the cancel runs";
+}
+
+TEST(GrpcPlannerClientCancelTest, CancelCallsEndsTheWaitForAPlannerThatIsAway) {
+  GrpcPlannerClient client("127.0.0.1:1");  // the default 15 s budget
+  const auto [took, error] = CancelledAfter(client, std::chrono::milliseconds(300), [&] {
+    client.PlanPick(v1::PlanPickRequest(), std::chrono::seconds(300));
+  });
+  ASSERT_TRUE(error);
+  EXPECT_EQ(error->code(), grpc::StatusCode::CANCELLED) << error->what();
+  EXPECT_LT(took, std::chrono::milliseconds(1500));
+}
+
 TEST(GrpcPlannerClientOptionsTest, BadOptionsAreRejected) {
   GrpcPlannerClientOptions options;
   options.initial_backoff = std::chrono::milliseconds(500);

@@ -4,8 +4,11 @@
 // cannot run in CI, so each fake answers from a queue the test fills and records what it was asked.
 
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
 #include <deque>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -229,8 +232,17 @@ class ScriptedPlanner final : public PlannerClient {
   std::vector<v1::PlanPickRequest> plan_requests;
   std::vector<v1::AnalyzeWrenchRequest> wrench_requests;
 
+  /// PlanPick blocks (a long plan) until CancelCalls, then throws CANCELLED.
+  bool block_plans = false;
+  std::atomic<int> cancels{0};
+
   v1::PlanPickResponse PlanPick(const v1::PlanPickRequest& request, std::chrono::milliseconds) override {
     plan_requests.push_back(request);
+    if (block_plans) {
+      std::unique_lock lock(block_mutex_);
+      block_cv_.wait(lock, [this] { return cancels.load() > 0; });
+      throw PlannerError("PlanPick", grpc::StatusCode::CANCELLED, "cancelled: the run is stopping", 1);
+    }
     if (plan_answers.empty()) {  // nothing scripted: the bin is empty
       v1::PlanPickResponse empty;
       empty.set_bin_empty(true);
@@ -240,6 +252,11 @@ class ScriptedPlanner final : public PlannerClient {
     plan_answers.pop_front();
     if (a.error) throw *a.error;
     return a.response;
+  }
+  void CancelCalls() override {
+    std::lock_guard lock(block_mutex_);
+    ++cancels;
+    block_cv_.notify_all();
   }
   v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
                                           std::chrono::milliseconds) override {
@@ -251,6 +268,10 @@ class ScriptedPlanner final : public PlannerClient {
     wrench_answers.pop_front();
     return a;
   }
+
+ private:
+  std::mutex block_mutex_;
+  std::condition_variable block_cv_;
 };
 
 /// X_BinTcp: the TCP pointing down (z_Tcp = -z_Bin) at `p_Bin_tcp`.

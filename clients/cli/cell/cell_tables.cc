@@ -46,7 +46,8 @@ std::string FormatCellTables(const CellStatistics& s, const std::string& title) 
   out += fmt::format("  {:<34}{:>7}/{} ({})\n", "bins emptied", s.bins_emptied, s.rounds,
                      Percent(s.bins_emptied, s.rounds));
   out += fmt::format("  {:<34}{:>7}/{}\n", "tubes picked", s.picks, s.tubes_total);
-  out += fmt::format("  {:<34}{:>7} limit, {} fault\n", "rounds stopped early", s.limit_stops, s.fault_stops);
+  out += fmt::format("  {:<34}{:>7} limit, {} fault, {} operator\n", "rounds stopped early", s.limit_stops,
+                     s.fault_stops, s.operator_stops);
   out += fmt::format("  {:<34}{:>7}\n", "bin reported empty, tubes left", s.false_empty);
   out += fmt::format("  {:<34}{:>7}\n", "tubes carried along or dropped out", s.tubes_lost);
   out += fmt::format("  {:<34}{:>7}\n", "tubes seen slipping out (lost)", s.lost_in_transit);

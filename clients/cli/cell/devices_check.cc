@@ -117,11 +117,13 @@ void CheckGripper(devices::Gripper& gripper, Timeout timeout, Row& row) {
                 {"opening_m", s.opening},
                 {"fault", s.fault}};
   row.pass = s.fault == 0;
-  row.detail = fmt::format("{}, {}, opening {:.1f} mm",
-                           s.activated ? "activated" : "not activated (a round activates it)",
-                           ObjectText(s.object), s.opening * 1000.0);
+  // Before activation a 2F-85 reports no motion status (gGTO 0): its object status means nothing yet.
+  row.detail = s.activated
+                   ? fmt::format("activated, {}, opening {:.1f} mm", ObjectText(s.object), s.opening * 1000.0)
+                   : fmt::format("answers, not activated (a round activates it), opening {:.1f} mm",
+                                 s.opening * 1000.0);
   if (s.fault != 0) row.detail += fmt::format("; FAULT 0x{:02X}: {}", s.fault, s.fault_text);
-  if (s.object == devices::GripperObject::kStoppedClosing) {
+  if (s.activated && s.object == devices::GripperObject::kStoppedClosing) {
     row.pass = false;
     row.detail += "; it reports an object held: empty the gripper before a round";
   }

@@ -57,7 +57,7 @@ ScanSocketServer::ScanSocketServer(std::string socket_path,
   ::unlink(path_.c_str());
   fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd_ < 0 || ::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0 ||
-      ::listen(fd_, 4) != 0 || ::pipe2(wake_, O_CLOEXEC) != 0) {
+      ::listen(fd_, 4) != 0) {
     const std::string why = std::strerror(errno);
     if (fd_ >= 0) ::close(fd_);
     throw std::runtime_error(fmt::format("scan socket {}: {}", path_, why));
@@ -66,24 +66,18 @@ ScanSocketServer::ScanSocketServer(std::string socket_path,
 }
 
 ScanSocketServer::~ScanSocketServer() {
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
+  wake_.Wake();
   thread_.join();
   ::close(fd_);
-  ::close(wake_[0]);
-  ::close(wake_[1]);
   ::unlink(path_.c_str());
 }
 
 void ScanSocketServer::Run() {
   for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
+    const devices::WakePipe::Event event = wake_.Wait(fd_);
+    if (event == devices::WakePipe::Event::kError)
       spdlog::error("scan socket {}: poll: {}", path_, std::strerror(errno));
-      return;
-    }
-    if (fds[1].revents != 0) return;
+    if (event != devices::WakePipe::Event::kReadable) return;
     const int client = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
     if (client < 0) continue;
     const std::string out = ReadLine(client);

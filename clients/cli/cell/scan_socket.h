@@ -4,6 +4,8 @@
 #include <string>
 #include <thread>
 
+#include "devices/virtual/wake_pipe.h"
+
 namespace tubepick::cli {
 
 /// The virtual cell's scanner bridge: a UNIX stream socket on which each connection asks for one
@@ -28,7 +30,7 @@ class ScanSocketServer {
   std::string path_;
   std::function<std::string(const std::string&)> serve_;
   int fd_ = -1;
-  int wake_[2] = {-1, -1};
+  devices::WakePipe wake_{"scan socket"};
   std::thread thread_;
 };
 
