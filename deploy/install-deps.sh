@@ -43,6 +43,7 @@ elif [ "$mode" = runtime ]; then
     libpcl-kdtree1.13
     libbullet3.24
     libspdlog1.10 libfmt9 libyaml-cpp0.7 libcurl4 libgomp1 libjemalloc2
+    libmodbus5  # tubepick: the Robotiq driver of `tubepick cell --devices` and `virtual-cell`
   )
 else
   packages=(

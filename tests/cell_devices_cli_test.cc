@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -25,11 +26,13 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using testing::RunCli;
 
-/// `tubepick ARGS` in the background, stdout and stderr into a file.
+/// `tubepick ARGS` (or another binary) in the background, stdout and stderr into a file.
 class BackgroundCli {
  public:
-  BackgroundCli(const std::vector<std::string>& args, const fs::path& log) : log_(log) {
-    std::vector<std::string> argv_strings{TUBEPICK_CLI};
+  BackgroundCli(const std::vector<std::string>& args, const fs::path& log,
+                const std::string& binary = TUBEPICK_CLI)
+      : log_(log) {
+    std::vector<std::string> argv_strings{binary};
     argv_strings.insert(argv_strings.end(), args.begin(), args.end());
     pid_ = ::fork();
     if (pid_ == 0) {
@@ -232,6 +235,38 @@ TEST(DevicesCheckTest, ACloudInTheWrongUnitFailsTheScannerRowNamingTheUnit) {
   EXPECT_NE(run.output.find("scanner    exec              FAIL"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("unit"), std::string::npos) << run.output;
   cell.Stop();
+}
+
+// The planner behind mutual TLS, as on a plant network: the cell connects with the same PEM files
+// the server takes, and without its client certificate it is refused with the likely cause.
+TEST(CellTlsTest, ARoundAgainstAPlannerThatRequiresMutualTls) {
+  const auto dir = testing::TempDir("cell_tls");
+  ASSERT_EQ(
+      std::system(
+          ("sh " TUBEPICK_SOURCE_DIR "/tests/test_certs.sh " + dir.string() + " >/dev/null 2>&1").c_str()),
+      0);
+  std::ofstream(dir / "server.yaml")
+      << "server:\n  tls:\n    cert_file: server.pem\n    key_file: server.key\n"
+         "    client_ca_file: ca.pem\n    require_client_cert: true\n";
+  BackgroundCli server(
+      {"--config", (dir / "server.yaml").string(), "--address", "127.0.0.1:0", "--metrics-address", ""},
+      dir / "server.log", TUBEPICK_SERVER);
+  const std::string port = server.WaitFor("listening on 127\\.0\\.0\\.1:(\\d+)", 60s);
+  ASSERT_FALSE(port.empty()) << server.Output();
+  const std::string planner = " --server 127.0.0.1:" + port + " --tls-ca " + (dir / "ca.pem").string();
+
+  const testing::CliRun run =
+      RunCli("cell --sim --rounds 1 --tubes 2 --seed 4" + planner + " --tls-cert " +
+             (dir / "client.pem").string() + " --tls-key " + (dir / "client.key").string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("bin empty: 2 tubes picked"), std::string::npos) << run.output;
+
+  // No client certificate: the planner refuses the handshake; the round safe-stops, saying why.
+  const testing::CliRun refused = RunCli("cell --sim --rounds 1 --tubes 1" + planner);
+  EXPECT_EQ(refused.exit_code, 3) << refused.output;
+  EXPECT_NE(refused.output.find("requires mutual TLS"), std::string::npos) << refused.output;
+  server.Signal(SIGTERM);
+  EXPECT_EQ(server.Wait(30s), 0) << server.Output();
 }
 
 TEST(CellOperatorStopTest, SigintDuringARoundEndsInTheSafeStopAndExit130) {

@@ -17,5 +17,6 @@ if(TARGET tubepick-server)
   target_include_directories(cell_devices_cli_test PRIVATE ${PROJECT_SOURCE_DIR})
   add_dependencies(cell_devices_cli_test tubepick tubepick-server)
   target_compile_definitions(cell_devices_cli_test PRIVATE TUBEPICK_CLI="$<TARGET_FILE:tubepick>"
+                                                        TUBEPICK_SERVER="$<TARGET_FILE:tubepick-server>"
                                                         TUBEPICK_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()
