@@ -267,6 +267,11 @@ TEST(CellTlsTest, ARoundAgainstAPlannerThatRequiresMutualTls) {
   EXPECT_NE(refused.output.find("requires mutual TLS"), std::string::npos) << refused.output;
   server.Signal(SIGTERM);
   EXPECT_EQ(server.Wait(30s), 0) << server.Output();
+
+  // TLS options with the private plaintext planner are a mistake, said at once.
+  const testing::CliRun mixed = RunCli("cell --sim --tls-ca " + (dir / "ca.pem").string());
+  EXPECT_EQ(mixed.exit_code, 2) << mixed.output;
+  EXPECT_NE(mixed.output.find("--server auto starts is plaintext"), std::string::npos) << mixed.output;
 }
 
 TEST(CellOperatorStopTest, SigintDuringARoundEndsInTheSafeStopAndExit130) {

@@ -228,6 +228,12 @@ void Run(const CellOptions& o) {
     fmt::print("{}", devices::ExampleDevicesConfig());
     return;
   }
+  const cell::GrpcPlannerClientOptions& tls = o.planner_options;
+  if (o.server == "auto" &&
+      !(tls.tls_ca_file.empty() && tls.tls_cert_file.empty() && tls.tls_server_name.empty()))
+    throw InvalidArgument(
+        "--tls-*: the planner --server auto starts is plaintext on loopback; give the TLS planner's --server "
+        "HOST:PORT");
   if (o.sim && !o.devices_path.empty())
     throw InvalidArgument("--sim and --devices: give one (--sim is the all-simulated cell)");
   if (!o.sim && o.devices_path.empty())
