@@ -95,6 +95,16 @@ cell::CellControllerParams ControllerParams(const CellOptions& o) {
   return params;
 }
 
+/// Every record kept in memory (for the tables) and, with --records, written as JSON lines.
+struct RecordSinks {
+  explicit RecordSinks(const std::string& path)
+      : file(path.empty() ? nullptr : std::make_unique<cell::JsonLinesFileSink>(path)),
+        tee(&memory, file.get()) {}
+  cell::MemoryRecordSink memory;
+  std::unique_ptr<cell::JsonLinesFileSink> file;
+  cell::TeeRecordSink tee;
+};
+
 /// The planner of the run: `--server auto` starts tubepick-server (its own process group, dies
 /// with this process), else the address given.
 std::unique_ptr<RestartableServer> StartPlanner(const CellOptions& o, std::string& address) {
@@ -159,10 +169,8 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   std::unique_ptr<RestartableServer> server = StartPlanner(o, address);
   cell::GrpcPlannerClient planner(address, o.planner_options);
 
-  cell::MemoryRecordSink memory;
-  std::unique_ptr<cell::JsonLinesFileSink> file;
-  if (!o.records_path.empty()) file = std::make_unique<cell::JsonLinesFileSink>(o.records_path);
-  cell::TeeRecordSink sink(&memory, file.get());
+  RecordSinks records(o.records_path);
+  cell::RecordSink& sink = records.tee;
 
   if (o.dry_run) {
     cell::CellControllerParams params = base_params;
@@ -183,9 +191,8 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
     params.seed = (o.seed + round) * 1000;
     const auto round_start = std::chrono::steady_clock::now();
     cell::CellController controller(opened.devices, planner, opened.cell, params, &sink);
-    const auto wall_start = std::chrono::steady_clock::now();
-    controller.set_device_clock([wall_start] {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    controller.set_device_clock([round_start] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     });
     cell::CellRunResult result;
     {
@@ -203,7 +210,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
       break;  // a real cell does not carry on after a safe stop: the operator looks first
     }
   }
-  const cell::CellStatistics stats = cell::SummarizeRecords(memory.records());
+  const cell::CellStatistics stats = cell::SummarizeRecords(records.memory.records());
   fmt::print("\n{}", FormatCellTables(stats, fmt::format("{}, {} round{}", o.devices_path, stats.rounds,
                                                          stats.rounds == 1 ? "" : "s")));
   if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
@@ -222,8 +229,6 @@ void Run(const CellOptions& o) {
     fmt::print("{}", cell::DumpCellControllerParams(base_params));
     return;
   }
-  const bool custom_cell = !o.cell_path.empty();
-  const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
   if (o.print_devices_config) {
     fmt::print("{}", devices::ExampleDevicesConfig());
     return;
@@ -243,6 +248,8 @@ void Run(const CellOptions& o) {
   if (!o.devices_path.empty()) return RunOnDevices(o, base_params);
   if (o.dry_run)
     throw InvalidArgument("--dry-run: with --devices FILE (the simulated cell has nothing to spare)");
+  const bool custom_cell = !o.cell_path.empty();  // --devices: OpenCell reads it
+  const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
   if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
   if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
   const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
@@ -260,10 +267,8 @@ void Run(const CellOptions& o) {
   FaultCampaign campaign;
   cell::GrpcPlannerClient planner(address, o.planner_options);
 
-  cell::MemoryRecordSink memory;
-  std::unique_ptr<cell::JsonLinesFileSink> file;
-  if (!o.records_path.empty()) file = std::make_unique<cell::JsonLinesFileSink>(o.records_path);
-  cell::TeeRecordSink sink(&memory, file.get());
+  RecordSinks records(o.records_path);
+  cell::RecordSink& sink = records.tee;
 
   json rounds_json = json::array();
   bool any_fault = false;
@@ -296,19 +301,13 @@ void Run(const CellOptions& o) {
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         result.attempts, result.scans, r.simulated_s, wall);
     std::fflush(stdout);
-    rounds_json.push_back({{"round", round},
-                           {"seed", o.seed + round},
-                           {"reason", cell::ToString(result.reason)},
-                           {"message", result.message},
-                           {"picks", result.picks},
-                           {"tubes_left", left},
-                           {"lost_in_transit", result.lost},
-                           {"released_outside", r.tubes_elsewhere},
-                           {"still_held", r.tubes_held},
-                           {"attempts", result.attempts},
-                           {"scans", result.scans},
-                           {"simulated_s", r.simulated_s},
-                           {"wall_s", wall}});
+    json round_json = RoundJson(round, result, wall);
+    round_json.update({{"seed", o.seed + round},
+                       {"tubes_left", left},
+                       {"released_outside", r.tubes_elsewhere},
+                       {"still_held", r.tubes_held},
+                       {"simulated_s", r.simulated_s}});
+    rounds_json.push_back(std::move(round_json));
     if (result.reason == cell::CellStopReason::kFault) {
       any_fault = true;
       if (!injecting && result.fault && result.fault->kind() == cell::FaultKind::kServerUnavailable) {
@@ -318,7 +317,7 @@ void Run(const CellOptions& o) {
     }
   }
 
-  const cell::CellStatistics stats = cell::SummarizeRecords(memory.records());
+  const cell::CellStatistics stats = cell::SummarizeRecords(records.memory.records());
   fmt::print("\n{}", FormatCellTables(
                          stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
                                             stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));

@@ -13,6 +13,7 @@
 #include "clients/cli/cell/cell_devices.h"
 #include "core/common/errors.h"
 #include "core/modeling/cloud_plausibility.h"
+#include "core/modeling/cloud_prepare.h"
 #include "devices/devices_config.h"
 
 namespace tubepick::cli {
@@ -174,16 +175,17 @@ void CheckScanner(devices::Scanner& scanner, const CellConfig& cell, Timeout tim
   const auto start = Clock::now();
   const devices::Capture capture = scanner.Scan(timeout);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  const double scale = MetresPer(capture.unit);
-  Points points_Bin;
-  points_Bin.reserve(capture.points_Sensor.size());
-  const Eigen::Isometry3f X = capture.X_BinSensor.cast<float>();
-  for (const Eigen::Vector3f& p : capture.points_Sensor)
-    if (p.allFinite()) points_Bin.push_back(X * (p * static_cast<float>(scale)));
-  const PlausibilityParams params;
-  const CloudPlausibility evidence = CheckCloudAgainstCell(points_Bin, cell.bin, params);
+  // The planner's own pass over a cloud (unit, bin frame, non-finite points, plausibility), keeping
+  // no points: only the evidence is wanted.
+  PrepareSpec spec;
+  spec.crop_Bin = std::make_pair(Eigen::Vector3f::Ones().eval(), Eigen::Vector3f::Zero().eval());  // empty
+  spec.raw_region_Bin = RawRegion::None();
+  spec.bin = cell.bin;
+  const PreparedCloud prepared = PrepareCloud(capture.points_Sensor, capture.unit, capture.X_BinSensor, spec);
+  const CloudPlausibility& evidence = prepared.plausibility;
+  const PlausibilityParams& params = spec.plausibility;
   row.values = {{"points", capture.points_Sensor.size()},
-                {"finite_points", points_Bin.size()},
+                {"finite_points", prepared.input_points - prepared.dropped_non_finite},
                 {"scan_s", seconds},
                 {"extent_m", {evidence.extent.x(), evidence.extent.y(), evidence.extent.z()}},
                 {"inside_share", evidence.inside_share},
