@@ -14,6 +14,7 @@
 #include "clients/cli/local/params_command.h"
 #include "clients/cli/local/plan_command.h"
 #include "clients/cli/local/scene_command.h"
+#include "clients/cli/local/view_command.h"
 #include "clients/cli/remote/health_command.h"
 #include "clients/cli/remote/request_command.h"
 #include "core/common/errors.h"
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   tubepick::cli::AddModelCommand(app);
   tubepick::cli::AddParamsCommand(app);
   tubepick::cli::AddPlanCommand(app);
+  tubepick::cli::AddViewCommand(app);
   tubepick::cli::AddBenchServiceCommand(*tubepick::cli::AddBenchCommand(app));
   tubepick::cli::AddSceneCommand(app);
   tubepick::cli::AddEvalCommand(app);

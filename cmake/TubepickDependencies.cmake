@@ -10,6 +10,11 @@ find_package(OpenMP REQUIRED COMPONENTS CXX)
 find_package(Protobuf REQUIRED)
 find_package(gRPC CONFIG REQUIRED)
 find_package(CURL REQUIRED)
+# cpp-httplib: the server's HTTP side (/metrics, /healthz, /debug/calls). Debian builds it as a
+# shared library with OpenSSL, zlib and Brotli support; its pkg-config file carries the matching
+# definitions, which the header's class layouts depend on.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 if(TUBEPICK_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

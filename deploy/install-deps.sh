@@ -4,7 +4,8 @@
 # Non-interactive and idempotent: safe to run again; it only installs what is missing.
 # The Dockerfile and CI (.ci/run) call this very script, so the three never drift apart.
 #
-#   deploy/install-deps.sh                build + test dependencies and the npm tools (CI, developers)
+#   deploy/install-deps.sh                build + test dependencies (chromium for the viewer's browser
+#                                         test included) and the npm packages (CI, developers)
 #   deploy/install-deps.sh --image-build  only what compiles the two shipped binaries (the Dockerfile's
 #                                         build stage): no test, benchmark or sanitizer tooling, no npm
 #   deploy/install-deps.sh --runtime      only the shared libraries tubepick-server and tubepick load at
@@ -27,7 +28,7 @@ library_dev_packages=(
   libeigen3-dev libpcl-dev libbullet-dev libbullet-extras-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
-  libmodbus-dev libcurl4-openssl-dev libjemalloc-dev
+  libmodbus-dev libcurl4-openssl-dev libjemalloc-dev libcpp-httplib-dev
 )
 
 if [ "$mode" = image-tools ]; then
@@ -44,6 +45,7 @@ elif [ "$mode" = runtime ]; then
     libbullet3.24
     libspdlog1.10 libfmt9 libyaml-cpp0.7 libcurl4 libgomp1 libjemalloc2
     libmodbus5  # tubepick: the Robotiq driver of `tubepick cell --devices` and `virtual-cell`
+    libcpp-httplib0.11  # tubepick-server: /metrics, /healthz, /debug/calls
   )
 else
   packages=(
@@ -55,6 +57,8 @@ else
     # deploy/ci/sanitizers.sh and fuzz.sh: clang with its sanitizer and libFuzzer runtimes, its
     # OpenMP, and llvm-symbolizer for the stack traces.
     clang libclang-rt-dev libomp-dev llvm
+    # tests/viewer_browser.sh: the 3-D pages in a real headless browser (playwright-core drives it)
+    chromium
   )
 fi
 

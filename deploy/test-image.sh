@@ -205,11 +205,20 @@ base() {
 }
 
 # --- 2. build -------------------------------------------------------------------------------------
+# The host's CA bundle, lent to the viewer stage's npm install (the Dockerfile's host_ca secret): where
+# a proxy inspects TLS, the registry's certificate chains to a CA only the host trusts.
+CA_SECRET=()
+[ -s /etc/ssl/certs/ca-certificates.crt ] && CA_SECRET=(--secret id=host_ca,src=/etc/ssl/certs/ca-certificates.crt)
 build_prerequisites() {
   local start=$SECONDS
   podman build --isolation chroot --network host --format docker --target deps -f deploy/Dockerfile . \
     >"$WORK/build-deps.log" 2>&1 || fail "podman build --target deps"
   say "dependency stage ready in $((SECONDS - start)) s"
+  start=$SECONDS
+  podman build --isolation chroot --network host --format docker "${CA_SECRET[@]}" --target viewer \
+    -f deploy/Dockerfile . \
+    >"$WORK/build-viewer.log" 2>&1 || fail "podman build --target viewer"
+  say "viewer stage (npm ci, page script bundled) ready in $((SECONDS - start)) s"
   start=$SECONDS
   podman build --isolation chroot --network host --format docker -f deploy/haproxy.Dockerfile \
     -t "$PROXY_IMAGE" . >"$WORK/build-proxy.log" 2>&1 || fail "podman build deploy/haproxy.Dockerfile"
@@ -225,8 +234,8 @@ build_images() {
     cache_flags=(--volume "$cache_dir:/ccache")
   fi
   local start=$SECONDS
-  podman build --isolation chroot --network host --format docker "${cache_flags[@]}" -f deploy/Dockerfile \
-    -t "$IMAGE" . >"$WORK/build-image.log" 2>&1 || fail "podman build deploy/Dockerfile"
+  podman build --isolation chroot --network host --format docker "${cache_flags[@]}" "${CA_SECRET[@]}" \
+    -f deploy/Dockerfile -t "$IMAGE" . >"$WORK/build-image.log" 2>&1 || fail "podman build deploy/Dockerfile"
   say "tubepick image built in $((SECONDS - start)) s${cache_dir:+ (compiler cache $cache_dir lent to the build stage)}"
   grep -a -o 'ccache-stats: Cacheable.*' "$WORK/build-image.log" | sed 's/^/test-image: /' || true
 }
@@ -298,6 +307,14 @@ run_server() {
   plans=$("$PY" -c 'import json,sys; print(len(json.load(open(sys.argv[1])).get("plans", [])))' "$WORK/plan.json")
   [ "$plans" -gt 0 ] || fail "PlanPick answered no plans: $(head -c 400 "$WORK/plan.json")"
   say "PlanPick of a 10-tube cloud: $plans plans"
+  # The HTTP side keeps no calls by default (debug.keep_last: 0) and says how to turn it on; the
+  # image's tubepick writes a viewer page (the page script embedded at build time).
+  local debug_answer
+  debug_answer=$(curl -sS -o /dev/stdout -w ' %{http_code}' http://127.0.0.1:9464/debug/calls) || fail "GET /debug/calls"
+  [[ "$debug_answer" == *"debug.keep_last is 0"*" 404" ]] || fail "/debug/calls: $debug_answer"
+  exec_in tubepick-run tubepick view --no-sim --tubes 3 --out /tmp/view.html >"$WORK/view.txt" 2>&1 \
+    || fail "tubepick view in the image: $(cat "$WORK/view.txt")"
+  say "/debug/calls off by default (404 naming debug.keep_last); $(head -n 1 "$WORK/view.txt")"
   stop_container tubepick-run TERM
   [ "$STOP_RC" = 0 ] || fail "tubepick-server exited $STOP_RC on SIGTERM"
   grep -q 'shut down after' "$WORK/tubepick-run.log" || fail "no 'shut down after' line in the server's log"

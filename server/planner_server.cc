@@ -19,8 +19,9 @@
 
 #include "core/common/thread_budget.h"
 #include "grpc/health/v1/health.pb.h"
+#include "server/debug_calls.h"
+#include "server/http_endpoints.h"
 #include "server/metrics.h"
-#include "server/metrics_http.h"
 #include "server/planner_service.h"
 #include "server/worker_pool.h"
 
@@ -109,7 +110,8 @@ struct PlannerServer::Impl {
   std::unique_ptr<Metrics> metrics;
   std::unique_ptr<PlannerService> service;
   std::unique_ptr<grpc::Server> server;
-  std::unique_ptr<MetricsHttpServer> http;
+  std::unique_ptr<DebugCallStore> debug_calls;
+  std::unique_ptr<HttpEndpoints> http;
   int port = 0;
   /// What grpc.health.v1 says, for the HTTP probe (/healthz): true from Start until Shutdown begins.
   std::atomic<bool> serving{false};
@@ -145,7 +147,9 @@ void PlannerServer::Start() {
 
   m.metrics = std::make_unique<Metrics>();
   m.pool = std::make_unique<WorkerPool>(WorkerCount(config), config.queue_capacity);
-  m.service = std::make_unique<PlannerService>(config, m.pool.get(), m.metrics.get());
+  if (config.debug.keep_last > 0)
+    m.debug_calls = std::make_unique<DebugCallStore>(config.debug.keep_last, config.debug.max_points);
+  m.service = std::make_unique<PlannerService>(config, m.pool.get(), m.metrics.get(), m.debug_calls.get());
 
   grpc::ServerBuilder builder;
   if (!config.reflection) builder.SetOption(std::make_unique<WithoutReflection>());
@@ -167,10 +171,13 @@ void PlannerServer::Start() {
 
   if (!config.metrics_address.empty()) {
     try {
-      m.http = std::make_unique<MetricsHttpServer>(
-          config.metrics_address,
-          [&m] { return m.metrics->RenderPrometheus(m.pool->load(), m.service->uploads_in_progress()); },
-          std::chrono::milliseconds(2000), [&m] { return m.serving.load(); });
+      HttpEndpointsOptions http;
+      http.render_metrics = [&m] {
+        return m.metrics->RenderPrometheus(m.pool->load(), m.service->uploads_in_progress());
+      };
+      http.serving = [&m] { return m.serving.load(); };
+      http.debug_calls = m.debug_calls.get();
+      m.http = std::make_unique<HttpEndpoints>(config.metrics_address, std::move(http));
     } catch (...) {
       m.server->Shutdown(std::chrono::system_clock::now());
       m.server.reset();
@@ -197,8 +204,12 @@ void PlannerServer::Start() {
         m.pool->workers(), ThreadsPerCall(config), CoresAvailable());
   }
   if (m.http) {
-    spdlog::info("metrics on http://{}:{}/metrics (health probe: /healthz)",
-                 HostForLog(SplitHostPort(config.metrics_address, "metrics_address").first), m.http->port());
+    const std::string http_host = HostForLog(SplitHostPort(config.metrics_address, "metrics_address").first);
+    spdlog::info("metrics on http://{}:{}/metrics (health probe: /healthz)", http_host, m.http->port());
+    if (m.debug_calls) {
+      spdlog::info("the last {} planning calls in the viewer at http://{}:{}/debug/calls (debug.keep_last)",
+                   config.debug.keep_last, http_host, m.http->port());
+    }
   }
 }
 

@@ -134,6 +134,8 @@ struct PlannerService::CallState {
   std::atomic<std::int64_t> cancelled_at{0};  // steady ns of OnCancel; 0 = not cancelled
   bool ran = false;                           // reached a worker and started
   CallRecord record;
+  /// The call's cloud, cell and response for /debug/calls (debug.keep_last > 0, once valid).
+  std::optional<DebugCapture> debug;
 };
 
 class PlannerService::UnaryCall final : public grpc::ServerUnaryReactor {
@@ -265,8 +267,10 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
       const grpc::Status status = service_->RunOnWorker(state_, enqueued, [this] {
         const PlanningJob job = ValidatePlanPick(assembler_.request(), cloud_, service_->config_.planning);
         state_.record.points = job.xyz_Sensor.size() / 12;
+        service_->CaptureForDebug(state_, job);
         *response_->mutable_response() =
             RunPlanPick(job, service_->config_.planning, service_->threads_per_call_, &state_.token);
+        if (state_.debug) state_.debug->frame.plan = response_->response();
         std::string().swap(cloud_);  // modeling read the bytes in place
         state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
         state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
@@ -314,8 +318,10 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
   std::shared_ptr<UploadWatch> watch_;
 };
 
-PlannerService::PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics)
+PlannerService::PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics,
+                               DebugCallStore* debug_calls)
     : config_(std::move(config)),
+      debug_calls_(debug_calls),
       threads_per_call_(ThreadsPerCall(config_)),
       pool_(pool),
       metrics_(metrics),
@@ -365,8 +371,19 @@ grpc::Status PlannerService::Conclude(CallState& call, grpc::Status status) {
   }
   metrics_->RecordCall(r.rpc, r.code, r.total_ms / 1000.0);
   LogCall(r);
+  if (debug_calls_ != nullptr && r.rpc != "AnalyzeWrench") debug_calls_->Add(r, std::move(call.debug));
   served_.fetch_add(1);
   return status;
+}
+
+void PlannerService::CaptureForDebug(CallState& call, const PlanningJob& job) const {
+  if (debug_calls_ == nullptr) return;
+  DebugCapture capture;
+  capture.cell = job.cell;
+  capture.tool = job.params.planning.tool;
+  capture.frame.cloud = viewer::ThinToBin(PackedXyz{job.xyz_Sensor}, job.unit, job.cell.sensor.X_BinSensor,
+                                          debug_calls_->max_points());
+  call.debug = std::move(capture);
 }
 
 grpc::Status PlannerService::RunOnWorker(CallState& call, Clock::time_point enqueued,
@@ -425,7 +442,9 @@ grpc::ServerUnaryReactor* PlannerService::ModelTubes(grpc::CallbackServerContext
   return StartPlanning(context, "ModelTubes", request->cloud().xyz().size() / 12,
                        [this, request, response](CallState& call) {
                          const PlanningJob job = ValidateModelTubes(*request, config_.planning);
+                         CaptureForDebug(call, job);
                          *response = RunModelTubes(job, threads_per_call_, &call.token);
+                         if (call.debug) call.debug->frame.modeling = *response;
                          call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
                        });
 }
@@ -436,7 +455,9 @@ grpc::ServerUnaryReactor* PlannerService::PlanPick(grpc::CallbackServerContext* 
   return StartPlanning(context, "PlanPick", request->cloud().xyz().size() / 12,
                        [this, request, response](CallState& call) {
                          const PlanningJob job = ValidatePlanPick(*request, config_.planning);
+                         CaptureForDebug(call, job);
                          *response = RunPlanPick(job, config_.planning, threads_per_call_, &call.token);
+                         if (call.debug) call.debug->frame.plan = *response;
                          call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
                          call.record.plans = static_cast<std::uint32_t>(response->plans_size());
                        });

@@ -8,7 +8,9 @@
 #include <string>
 
 #include "core/common/stop_token.h"
+#include "server/debug_calls.h"
 #include "server/metrics.h"
+#include "server/request_validation.h"
 #include "server/server_config.h"
 #include "server/upload_slots.h"
 #include "server/upload_watchdog.h"
@@ -37,8 +39,10 @@ namespace tubepick::server {
 ///   request id).
 class PlannerService final : public v1::PickPlannerService::CallbackService {
  public:
-  /// `pool` and `metrics` must outlive the service.
-  PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics);
+  /// `pool` and `metrics` must outlive the service; so must `debug_calls` (null = keep no calls), which
+  /// gets every ModelTubes, PlanPick and PlanPickStream call as it is answered (debug.keep_last).
+  PlannerService(ServerConfig config, WorkerPool* pool, Metrics* metrics,
+                 DebugCallStore* debug_calls = nullptr);
 
   grpc::ServerUnaryReactor* ModelTubes(grpc::CallbackServerContext* context,
                                        const v1::ModelTubesRequest* request,
@@ -74,10 +78,13 @@ class PlannerService final : public v1::PickPlannerService::CallbackService {
                            const std::function<void()>& body);
   grpc::Status Rejected(const CallState& call);
   grpc::Status Conclude(CallState& call, grpc::Status status);
+  /// With debug.keep_last: keeps the job's cloud (thinned, bin frame) and cell for the call's page.
+  void CaptureForDebug(CallState& call, const PlanningJob& job) const;
   void Register(StopToken* token);
   void Unregister(StopToken* token);
 
   const ServerConfig config_;
+  DebugCallStore* const debug_calls_;
   const std::uint32_t threads_per_call_;
   WorkerPool* pool_;
   Metrics* metrics_;

@@ -42,6 +42,15 @@ void DescribeFields(Visit& v, TlsConfig& tls) {
     "Reject clients without a valid certificate (needs client_ca_file).");
 }
 
+// The `debug` section (beside DebugConfig, where the config visitors look for it).
+template <typename Visit>
+void DescribeFields(Visit& v, DebugConfig& d) {
+  v("keep_last", d.keep_last,
+    "Keep the last N planning calls (cloud thinned, response or error) and show them in the 3-D\n"
+    "viewer at http://METRICS_ADDRESS/debug/calls; 0 = off. Needs server.metrics_address.");
+  v("max_points", d.max_points, "Cloud points kept per call (every k-th point).");
+}
+
 namespace {
 
 constexpr std::uint64_t kMiB = 1ull << 20;
@@ -206,6 +215,7 @@ template <typename Visit>
 void DescribeFields(Visit& v, ServerFile& file) {
   ServerSection server{file.config};
   v.Section("server", server);
+  v.Section("debug", file.config.debug, "The viewer of recent calls on the HTTP port (off by default).");
   PlanningSection planning{file.config.planning, file.params_file};
   v.Section("planning", planning);
   v.Heading(
@@ -334,6 +344,18 @@ void ValidateHostPort(const std::string& address, const std::string& key) {
 void ServerConfig::Validate() const {
   ValidateHostPort(address, "server.address");
   if (!metrics_address.empty()) ValidateHostPort(metrics_address, "server.metrics_address");
+  if (debug.keep_last > 1000) {
+    throw InvalidArgument(fmt::format("debug.keep_last: {} is out of range [0, 1000]", debug.keep_last));
+  }
+  if (debug.keep_last > 0 && metrics_address.empty()) {
+    throw InvalidArgument(fmt::format(
+        "debug.keep_last: {} needs server.metrics_address (its HTTP port serves /debug/calls), which is off",
+        debug.keep_last));
+  }
+  if (debug.max_points < 1000 || debug.max_points > 5'000'000) {
+    throw InvalidArgument(
+        fmt::format("debug.max_points: {} is out of range [1000, 5000000]", debug.max_points));
+  }
   if (workers > 1024) {
     throw InvalidArgument("server.workers: " + std::to_string(workers) + " is out of range [0, 1024]");
   }

@@ -64,6 +64,15 @@ struct ConnectionLimits {
   std::uint32_t max_concurrent_streams = 32;
 };
 
+/// What the server keeps of its last planning calls for the viewer on its HTTP port (/debug/calls,
+/// docs/VIEWER.md): the thinned cloud, the response or error. Off by default.
+struct DebugConfig {
+  /// Planning calls kept, newest first; 0 = none (and /debug/calls answers 404).
+  std::uint32_t keep_last = 0;
+  /// Cloud points kept per call (every k-th point, bin frame).
+  std::uint32_t max_points = 200'000;
+};
+
 /// The whole server configuration (`tubepick-server --config FILE`; EmbeddedServerConfigYaml() is the
 /// default). Every key is optional; unknown keys are errors.
 struct ServerConfig {
@@ -105,6 +114,7 @@ struct ServerConfig {
   /// "text" or "json" (one JSON object per line).
   std::string log_format = "text";
   TlsConfig tls;
+  DebugConfig debug;
   PlanningDefaults planning;
 
   /// @throws InvalidArgument naming the first bad field and its value.

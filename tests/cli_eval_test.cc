@@ -1,5 +1,6 @@
 // End-to-end: `tubepick scene` writes two small simulated bins, `tubepick eval --scenes` models
 // and evaluates them and writes the report.
+#include <fmt/core.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -71,6 +72,24 @@ TEST(CliEval, SceneThenEvalWritesAConsistentReport) {
   EXPECT_TRUE(fs::exists(report / "images" / "accuracy_time.svg"));
   EXPECT_TRUE(fs::exists(report / "images" / "scene_one.svg"));
   EXPECT_THAT(ReadText(report / "images" / "scene_one.svg"), HasSubstr("<svg"));
+  // Each scene has its 3-D page: the modeled tubes of report.json over the scene's cloud.
+  EXPECT_THAT(md, HasSubstr("`views/SCENE.html`"));
+  for (const auto& scene : j["scenes"]) {
+    const std::string view = scene["view"];
+    EXPECT_EQ(view, "views/" + scene["name"].get<std::string>() + ".html");
+    const std::string html = ReadText(report / view);
+    const std::string open = "id=\"tubepick-data\">";
+    const std::size_t begin = html.find(open) + open.size();
+    const nlohmann::json page =
+        nlohmann::json::parse(html.substr(begin, html.find("</script>", begin) - begin));
+    ASSERT_EQ(page["frames"].size(), 1u);
+    EXPECT_EQ(page["frames"][0]["modeling"]["tubes"].size(), scene["virtual_tubes"].size());
+    EXPECT_LE(page["frames"][0]["cloud"]["points"].get<int>(), 50000);
+    EXPECT_GT(page["frames"][0]["cloud"]["points"].get<int>(), 10000);
+    EXPECT_THAT(page["frames"][0]["note"].get<std::string>(),
+                HasSubstr(fmt::format("{} of {} tubes correct", scene["correct"].get<int>(),
+                                      scene["tube_count"].get<int>())));
+  }
   fs::remove_all(dir);
 }
 

@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "core/common/errors.h"
+#include "server/http_endpoints.h"
 #include "server/metrics.h"
-#include "server/metrics_http.h"
 #include "server/request_log.h"
 #include "server/upload_slots.h"
 #include "server/upload_watchdog.h"
@@ -190,53 +190,78 @@ TEST(Metrics, ProcessMemoryComesFromProc) {
   EXPECT_GE(memory->peak_resident_bytes, memory->resident_bytes);
 }
 
-// --- metrics HTTP ----------------------------------------------------------------------------------
+// --- HTTP endpoints (/metrics, /healthz, /debug/calls) -----------------------------------------------
 
-TEST(MetricsHttp, RoutesAndRejects) {
-  const auto render = [] { return std::string("up 1\n"); };
-  HttpReply r = HandleMetricsRequest("GET /metrics HTTP/1.1\r\nHost: a\r\n", render);
-  EXPECT_EQ(r.status, 200);
-  EXPECT_EQ(r.content_type, "text/plain; version=0.0.4; charset=utf-8");
-  EXPECT_EQ(r.body, "up 1\n");
-  EXPECT_EQ(HandleMetricsRequest("GET /metrics?name[]=x HTTP/1.0\r\n", render).status, 200);
-  EXPECT_EQ(HandleMetricsRequest("GET /metricsx HTTP/1.1\r\n", render).status, 404);
-  EXPECT_EQ(HandleMetricsRequest("GET / HTTP/1.1\r\n", render).status, 404);
-  EXPECT_EQ(HandleMetricsRequest("DELETE /metrics HTTP/1.1\r\n", render).status, 405);
-  EXPECT_EQ(HandleMetricsRequest("GET /metrics HTTP/2.0\r\n", render).status, 400);
-  EXPECT_EQ(HandleMetricsRequest("GET /metrics\r\n", render).status, 400);
-  EXPECT_EQ(HandleMetricsRequest("GET  /metrics HTTP/1.1\r\n", render).status, 400);
-  EXPECT_EQ(HandleMetricsRequest("", render).status, 400);
-  EXPECT_EQ(HandleMetricsRequest(std::string("GET /met\0rics HTTP/1.1\r\n", 24), render).status, 400);
+HttpEndpointsOptions MetricsOnly(std::function<bool()> serving = {}) {
+  HttpEndpointsOptions o;
+  o.render_metrics = [] { return std::string("up 1\n"); };
+  o.serving = std::move(serving);
+  o.io_timeout = std::chrono::milliseconds(300);
+  return o;
 }
 
-TEST(MetricsHttp, HealthProbeFollowsTheServingState) {
-  const auto render = [] { return std::string("up 1\n"); };
-  bool serving = true;
-  const std::function<bool()> state = [&serving] { return serving; };
-  HttpReply r = HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render, state);
-  EXPECT_EQ(r.status, 200);
-  EXPECT_EQ(r.body, "SERVING\n");
-  EXPECT_EQ(HandleMetricsRequest("HEAD /healthz?probe=1 HTTP/1.0\r\n", render, state).status, 200);
-  serving = false;
-  r = HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render, state);
-  EXPECT_EQ(r.status, 503);
-  EXPECT_EQ(r.body, "NOT_SERVING\n");
-  EXPECT_EQ(HandleMetricsRequest("POST /healthz HTTP/1.1\r\n", render, state).status, 405);
-  // Without a serving state there is no probe to answer.
-  EXPECT_EQ(HandleMetricsRequest("GET /healthz HTTP/1.1\r\n", render).status, 404);
-}
+bool StartsWith(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
 
-TEST(MetricsHttp, SlowAndBrokenClientsDoNotStopTheEndpoint) {
-  MetricsHttpServer http(
-      "127.0.0.1:0", [] { return std::string("up 1\n"); }, std::chrono::milliseconds(200));
+TEST(HttpEndpoints, RoutesAndRejects) {
+  HttpEndpoints http("127.0.0.1:0", MetricsOnly());
   ASSERT_GT(http.port(), 0);
-  // A client that sends half a request and waits is answered 408 after the I/O budget.
+  const std::string ok = HttpExchange(http.port(), "GET /metrics HTTP/1.1\r\nHost: a\r\n\r\n");
+  EXPECT_TRUE(StartsWith(ok, "HTTP/1.1 200 OK\r\n")) << ok;
+  EXPECT_THAT(ok, HasSubstr("Content-Type: text/plain; version=0.0.4; charset=utf-8\r\n"));
+  EXPECT_THAT(ok, HasSubstr("Content-Length: 5\r\n"));
+  EXPECT_THAT(ok, HasSubstr("\r\n\r\nup 1\n"));
+  EXPECT_TRUE(
+      StartsWith(HttpExchange(http.port(), "GET /metrics?name[]=x HTTP/1.0\r\n\r\n"), "HTTP/1.1 200 "));
+  const std::string head = HttpExchange(http.port(), "HEAD /metrics HTTP/1.1\r\nHost: a\r\n\r\n");
+  EXPECT_TRUE(StartsWith(head, "HTTP/1.1 200 ")) << head;
+  EXPECT_THAT(head, ::testing::Not(HasSubstr("up 1")));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET /metricsx HTTP/1.1\r\n\r\n"), "HTTP/1.1 404 "));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET / HTTP/1.1\r\n\r\n"), "HTTP/1.1 404 "));
+  const std::string del = HttpExchange(http.port(), "DELETE /metrics HTTP/1.1\r\n\r\n");
+  EXPECT_TRUE(StartsWith(del, "HTTP/1.1 405 ")) << del;
+  EXPECT_THAT(del, HasSubstr("Allow: GET, HEAD\r\n"));
+  // Without the debug store the viewer paths say how to turn it on.
+  const std::string debug = HttpExchange(http.port(), "GET /debug/calls HTTP/1.1\r\n\r\n");
+  EXPECT_TRUE(StartsWith(debug, "HTTP/1.1 404 ")) << debug;
+  EXPECT_THAT(debug, HasSubstr("debug.keep_last is 0"));
+  // Without a serving state there is no probe to answer.
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET /healthz HTTP/1.1\r\n\r\n"), "HTTP/1.1 404 "));
+}
+
+TEST(HttpEndpoints, HealthProbeFollowsTheServingState) {
+  std::atomic<bool> serving{true};
+  HttpEndpoints http("127.0.0.1:0", MetricsOnly([&serving] { return serving.load(); }));
+  std::string r = HttpExchange(http.port(), "GET /healthz HTTP/1.1\r\n\r\n");
+  EXPECT_TRUE(StartsWith(r, "HTTP/1.1 200 ")) << r;
+  EXPECT_THAT(r, HasSubstr("\r\n\r\nSERVING\n"));
+  EXPECT_TRUE(
+      StartsWith(HttpExchange(http.port(), "HEAD /healthz?probe=1 HTTP/1.0\r\n\r\n"), "HTTP/1.1 200 "));
+  serving = false;
+  r = HttpExchange(http.port(), "GET /healthz HTTP/1.1\r\n\r\n");
+  EXPECT_TRUE(StartsWith(r, "HTTP/1.1 503 ")) << r;
+  EXPECT_THAT(r, HasSubstr("\r\n\r\nNOT_SERVING\n"));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "POST /healthz HTTP/1.1\r\n\r\n"), "HTTP/1.1 405 "));
+}
+
+TEST(HttpEndpoints, SlowAndBrokenClientsDoNotStopTheEndpoint) {
+  HttpEndpoints http("127.0.0.1:0", MetricsOnly());
+  ASSERT_GT(http.port(), 0);
+  // A client that sends half a request and waits holds its connection for the I/O budget only, and
+  // the endpoint answers others meanwhile.
+  auto slow = std::async(std::launch::async, [&] {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string answer = HttpExchange(http.port(), "GET /metr");
+    return std::make_pair(answer, std::chrono::steady_clock::now() - start);
+  });
   const auto start = std::chrono::steady_clock::now();
-  const std::string slow = HttpExchange(http.port(), "GET /metr");
-  EXPECT_EQ(slow.rfind("HTTP/1.1 408 ", 0), 0u) << slow;
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(3));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET /metrics HTTP/1.1\r\n\r\n"), "HTTP/1.1 200 "));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(250));
+  const auto [answer, took] = slow.get();
+  EXPECT_THAT(answer, ::testing::Not(HasSubstr("up 1"))) << answer;
+  EXPECT_LT(took, std::chrono::seconds(3));
   // Oversized heads, connect-and-close, binary junk.
-  EXPECT_EQ(HttpExchange(http.port(), std::string(9000, 'x')).rfind("HTTP/1.1 431 ", 0), 0u);
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET /" + std::string(9000, 'x') + " HTTP/1.1\r\n\r\n"),
+                         "HTTP/1.1 414 "));
   {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in a{};
@@ -246,16 +271,13 @@ TEST(MetricsHttp, SlowAndBrokenClientsDoNotStopTheEndpoint) {
     ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
     ::close(fd);
   }
-  EXPECT_EQ(HttpExchange(http.port(), std::string("\0\1\2\3\r\n\r\n", 8)).rfind("HTTP/1.1 400 ", 0), 0u);
-  const std::string ok = HttpExchange(http.port(), "GET /metrics HTTP/1.1\r\n\r\n");
-  EXPECT_EQ(ok.rfind("HTTP/1.1 200 OK\r\n", 0), 0u);
-  EXPECT_THAT(ok, HasSubstr("Content-Length: 5\r\n"));
-  EXPECT_THAT(ok, HasSubstr("\r\n\r\nup 1\n"));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), std::string("\0\1\2\3\r\n\r\n", 8)), "HTTP/1.1 400 "));
+  EXPECT_TRUE(StartsWith(HttpExchange(http.port(), "GET /metrics HTTP/1.1\r\n\r\n"), "HTTP/1.1 200 OK\r\n"));
   http.Stop();
   http.Stop();  // idempotent
 }
 
-TEST(MetricsHttp, SplitsHostAndPort) {
+TEST(HttpEndpoints, SplitsHostAndPort) {
   EXPECT_EQ(SplitHostPort("0.0.0.0:9464", "a"), (std::pair<std::string, int>("0.0.0.0", 9464)));
   EXPECT_EQ(SplitHostPort("[::]:0", "a"), (std::pair<std::string, int>("::", 0)));
   EXPECT_EQ(SplitHostPort("localhost:80", "a"), (std::pair<std::string, int>("localhost", 80)));
@@ -263,7 +285,9 @@ TEST(MetricsHttp, SplitsHostAndPort) {
   EXPECT_THROW(SplitHostPort("localhost:", "a"), InvalidArgument);
   EXPECT_THROW(SplitHostPort("localhost:70000", "a"), InvalidArgument);
   EXPECT_THROW(SplitHostPort("localhost:8o", "a"), InvalidArgument);
-  EXPECT_THROW(MetricsHttpServer("127.0.0.1:99999", [] { return std::string(); }), InvalidArgument);
+  EXPECT_THROW(HttpEndpoints("127.0.0.1:99999", MetricsOnly()), InvalidArgument);
+  HttpEndpoints first("127.0.0.1:0", MetricsOnly());
+  EXPECT_THROW(HttpEndpoints("127.0.0.1:" + std::to_string(first.port()), MetricsOnly()), std::runtime_error);
 }
 
 // --- request log -----------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 # is generated at test time with the openssl CLI (tests/test_certs.sh) into a temporary directory.
 tubepick_add_test(service_test
   SOURCES service_test_support.cc service_rpc_test.cc service_stream_test.cc service_ops_test.cc
-          service_tls_test.cc service_process_test.cc service_parts_test.cc
+          service_tls_test.cc service_process_test.cc service_parts_test.cc service_debug_test.cc
   LIBS tubepick_server tubepick_core_testing tubepick_physics gRPC::grpc++ protobuf::libprotobuf
        nlohmann_json::nlohmann_json spdlog::spdlog)
 target_include_directories(service_test PRIVATE ${PROJECT_SOURCE_DIR})

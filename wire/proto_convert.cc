@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/core.h>
+
 #include "core/common/errors.h"
 #include "core/common/require.h"
 
@@ -226,6 +228,21 @@ std::string ToJson(const google::protobuf::Message& message, bool pretty) {
   const auto status = google::protobuf::util::MessageToJsonString(message, &json, options);
   if (!status.ok()) throw std::runtime_error("JSON conversion failed: " + std::string(status.message()));
   return json;
+}
+
+}  // namespace tubepick
+
+namespace tubepick {
+
+void FromJson(std::string_view json, google::protobuf::Message* message, const std::string& what) {
+  google::protobuf::util::JsonParseOptions options;
+  options.ignore_unknown_fields = false;
+  const auto status = google::protobuf::util::JsonStringToMessage(
+      google::protobuf::StringPiece(json.data(), json.size()), message, options);
+  if (!status.ok()) {
+    throw InvalidArgument(fmt::format("{} is not a {} in proto3 JSON: {}", what,
+                                      message->GetDescriptor()->name(), std::string(status.message())));
+  }
 }
 
 }  // namespace tubepick

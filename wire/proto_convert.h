@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <google/protobuf/message.h>
 #include <Eigen/Geometry>
@@ -56,5 +57,8 @@ std::string HeldOutcomeName(v1::HeldOutcome outcome);
 
 /// Proto3 JSON (field names as in the .proto, i.e. lowerCamelCase, enums by name).
 std::string ToJson(const google::protobuf::Message& message, bool pretty = true);
+/// Parses proto3 JSON into `message` (unknown fields are errors).
+/// @throws InvalidArgument naming `what` and the parser's reason.
+void FromJson(std::string_view json, google::protobuf::Message* message, const std::string& what);
 
 }  // namespace tubepick

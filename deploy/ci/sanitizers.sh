@@ -51,7 +51,7 @@ if [ "$what" != asan ]; then
   step "tsan configure" configure_tree build-tsan -DTUBEPICK_SANITIZE=thread
   step "tsan build (server_test service_test)" build_targets build-tsan server_test service_test
   step "tsan server_test" run_tests build-tsan server_test
-  step "tsan service_test (WorkerPool, UploadSlots, UploadWatchdog, Metrics, MetricsHttp, RequestLog)" \
-    run_tests build-tsan service_test -R '^(WorkerPool|UploadSlots|UploadWatchdog|Metrics|MetricsHttp|RequestLog)\.'
+  step "tsan service_test (WorkerPool, UploadSlots, UploadWatchdog, Metrics, HttpEndpoints, RequestLog)" \
+    run_tests build-tsan service_test -R '^(WorkerPool|UploadSlots|UploadWatchdog|Metrics|HttpEndpoints|RequestLog)\.'
 fi
 cat "$summary"

@@ -214,6 +214,19 @@ planning:
   EXPECT_EQ(c.planning.simulation.time_step, physics::TrajectorySimParams{}.time_step);
 }
 
+TEST(ServerConfig, DebugKeepsNoCallsByDefaultAndNeedsTheHttpPort) {
+  EXPECT_EQ(ServerConfig{}.debug.keep_last, 0u);
+  EXPECT_THAT(std::string(EmbeddedServerConfigYaml()), HasSubstr("keep_last: 0"));
+  const ServerConfig c = ParseServerConfig("debug: {keep_last: 20, max_points: 50000}\n");
+  EXPECT_EQ(c.debug.keep_last, 20u);
+  EXPECT_EQ(c.debug.max_points, 50000u);
+  EXPECT_THAT(ParseError("debug: {keep_last: 5}\nserver: {metrics_address: \"\"}\n"),
+              HasSubstr("debug.keep_last: 5 needs server.metrics_address"));
+  EXPECT_THAT(ParseError("debug: {keep_last: 1001}"), HasSubstr("debug.keep_last: 1001 is out of range"));
+  EXPECT_THAT(ParseError("debug: {max_points: 10}"), HasSubstr("debug.max_points: 10 is out of range"));
+  EXPECT_THAT(ParseError("debug: {keep: 5}"), HasSubstr("debug.keep"));
+}
+
 TEST(ServerConfig, ThreadBudgetSplitsTheAvailableCoresAmongWorkers) {
   ServerConfig c;
   c.workers = 0;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
@@ -22,6 +23,7 @@
 #include "clients/cli/cell/fault_injector.h"
 #include "clients/cli/cell/operator_stop.h"
 #include "clients/cli/cell/planner_outage.h"
+#include "clients/cli/cell/round_view.h"
 #include "clients/cli/cell/sim_round.h"
 #include "clients/cli/remote/server_process.h"
 #include "core/common/cell_config.h"
@@ -42,6 +44,8 @@ struct CellOptions {
   std::string server = "auto";
   std::uint64_t seed = 1;
   std::string records_path;
+  std::string view_dir;  ///< --view: a 3-D page per round
+  std::size_t view_points = 100'000;
   std::string json_path;
   std::string profile;
   std::string resolution;
@@ -95,14 +99,28 @@ cell::CellControllerParams ControllerParams(const CellOptions& o) {
   return params;
 }
 
-/// Every record kept in memory (for the tables) and, with --records, written as JSON lines.
+/// Every record kept in memory (for the tables) and, with --records, written as JSON lines; with
+/// --view, the round pages see every planner call and record on their way.
 struct RecordSinks {
-  explicit RecordSinks(const std::string& path)
-      : file(path.empty() ? nullptr : std::make_unique<cell::JsonLinesFileSink>(path)),
-        tee(&memory, file.get()) {}
+  RecordSinks(const CellOptions& o, cell::PlannerClient& planner_client)
+      : file(o.records_path.empty() ? nullptr : std::make_unique<cell::JsonLinesFileSink>(o.records_path)),
+        tee(&memory, file.get()) {
+    if (!o.view_dir.empty()) view.emplace(planner_client, tee, o.view_dir, o.view_points, ToolParams{});
+  }
+  cell::RecordSink& sink() { return view ? static_cast<cell::RecordSink&>(*view) : tee; }
+  cell::PlannerClient& planner(cell::PlannerClient& direct) {
+    return view ? static_cast<cell::PlannerClient&>(*view) : direct;
+  }
+  /// Where the pages went (after the run).
+  void PrintPages() const {
+    if (view && !view->pages().empty())
+      fmt::print("3-D pages: {} round page(s) in {} (open in a browser)\n", view->pages().size(),
+                 std::filesystem::path(view->pages().front()).parent_path().string());
+  }
   cell::MemoryRecordSink memory;
   std::unique_ptr<cell::JsonLinesFileSink> file;
   cell::TeeRecordSink tee;
+  std::optional<RoundViewRecorder> view;
 };
 
 /// The planner of the run: `--server auto` starts tubepick-server (its own process group, dies
@@ -167,10 +185,10 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   OperatorStop stop;
   std::string address;
   std::unique_ptr<RestartableServer> server = StartPlanner(o, address);
-  cell::GrpcPlannerClient planner(address, o.planner_options);
-
-  RecordSinks records(o.records_path);
-  cell::RecordSink& sink = records.tee;
+  cell::GrpcPlannerClient grpc_planner(address, o.planner_options);
+  RecordSinks records(o, grpc_planner);
+  cell::RecordSink& sink = records.sink();
+  cell::PlannerClient& planner = records.planner(grpc_planner);
 
   if (o.dry_run) {
     cell::CellControllerParams params = base_params;
@@ -214,6 +232,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   fmt::print("\n{}", FormatCellTables(stats, fmt::format("{}, {} round{}", o.devices_path, stats.rounds,
                                                          stats.rounds == 1 ? "" : "s")));
   if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  records.PrintPages();
   WriteJson(o.json_path, json{{"devices", o.devices_path},
                               {"seed", o.seed},
                               {"rounds", rounds_json},
@@ -265,10 +284,10 @@ void Run(const CellOptions& o) {
   if (!server && injecting)
     fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
   FaultCampaign campaign;
-  cell::GrpcPlannerClient planner(address, o.planner_options);
-
-  RecordSinks records(o.records_path);
-  cell::RecordSink& sink = records.tee;
+  cell::GrpcPlannerClient grpc_planner(address, o.planner_options);
+  RecordSinks records(o, grpc_planner);
+  cell::RecordSink& sink = records.sink();
+  cell::PlannerClient& planner = records.planner(grpc_planner);
 
   json rounds_json = json::array();
   bool any_fault = false;
@@ -322,6 +341,7 @@ void Run(const CellOptions& o) {
                          stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
                                             stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
   if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  records.PrintPages();
   if (injecting) fmt::print("{}\n{}\n", campaign.KindsLine(), campaign.SummaryLine());
   WriteJson(o.json_path, json{{"material", o.material},
                               {"tubes", o.tubes},
@@ -372,6 +392,12 @@ void AddCellCommand(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "Seed of the first round's cell and the planner seeds")
       ->capture_default_str();
   cmd->add_option("--records", o->records_path, "Write every attempt as a JSON line to this file");
+  cmd->add_option("--view", o->view_dir,
+                  "Write a 3-D page per round into this directory (round_NNN.html: each scan, its plans, the "
+                  "pick made and what came of it)");
+  cmd->add_option("--view-points", o->view_points, "Cloud points per scan in the --view pages")
+      ->check(CLI::Range(1000, 2'000'000))
+      ->capture_default_str();
   cmd->add_option("--json", o->json_path, "Write the per-round results and the statistics as JSON");
   CLI::Option* profile = cmd->add_option("--profile", o->profile,
                                          "Planner parameter profile (fast, thesis; default: the server's)");

@@ -22,6 +22,8 @@
 #include "core/evaluation/virtual_labelling.h"
 #include "core/modeling/model_tubes.h"
 #include "physics/tube_config_io.h"
+#include "viewer/view_page.h"
+#include "wire/response_convert.h"
 
 namespace tubepick::cli {
 namespace {
@@ -40,6 +42,8 @@ struct EvalOptions {
   std::string joining;  // "", "greedy", "global"
   std::uint32_t jobs = 1;
   std::uint32_t pictures_per_count = 2;
+  /// Cloud points of each scene's 3-D page; 0 = no pages.
+  std::uint32_t view_points = 50'000;
   std::string command_line;
 };
 
@@ -157,6 +161,35 @@ SceneSnapshot MakeSnapshot(const ModelingResult& result, const std::vector<std::
   return s;
 }
 
+// The scene's 3-D page, written as soon as the scene is done (pages are not kept in memory):
+// its cloud, the modeled tubes and the verdict. Returns its path relative to the report.
+std::string WriteScenePage(const EvaluatedScene& scene, const Points& points_Sensor, LengthUnit unit,
+                           const CellConfig& cell, const ModelingResult& result, const Params& params,
+                           const EvalOptions& o) {
+  std::string file = scene.name;
+  for (char& c : file) {
+    if (c == '/' || c == '\\' || c == ' ') c = '_';
+  }
+  file = "views/" + file + ".html";
+  viewer::ViewPage page;
+  page.title = fmt::format("tubepick eval: {}", scene.name);
+  page.source = o.command_line;
+  page.links.push_back({"report", "../report.md"});
+  page.cell = cell;
+  page.tool = params.planning.tool;
+  viewer::ViewFrame frame;
+  frame.label = fmt::format("scene {} ({})", scene.name, scene.source);
+  const SceneEvaluation& e = scene.evaluation;
+  frame.note = fmt::format(
+      "{} of {} tubes correct, {} partially, {} hidden; {} virtual tubes; micro-recall {:.3f}", e.correct,
+      e.real_tube_count, e.partially_correct, e.hidden, e.virtual_tubes.size(), e.micro_recall());
+  frame.cloud = viewer::ThinToBin(points_Sensor, unit, cell.sensor.X_BinSensor, o.view_points);
+  frame.modeling = ToModelTubesResponse(result, o.common.profile, o.common.seed);
+  page.frames.push_back(std::move(frame));
+  WriteTextFile((fs::path(o.report_dir) / file).string(), viewer::PageHtml(page));
+  return file;
+}
+
 EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const CellConfig& default_cell,
                            const Params& params, const EvaluationParams& eval_params) {
   EvaluatedScene out;
@@ -202,6 +235,9 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
       MakeModelingInput(points_Sensor, unit, cell, o.common.seed, RawRegion::None()), params.modeling);
   out.evaluation = EvaluateScene(result, labels, out.tube_count, eval_params);
   out.snapshot = MakeSnapshot(result, labels, tubes_Bin, eval_params, cell.bin);
+  if (o.view_points > 0) {
+    out.view_file = WriteScenePage(out, points_Sensor, unit, cell, result, params, o);
+  }
   return out;
 }
 
@@ -371,6 +407,9 @@ void AddEvalCommand(CLI::App& app) {
          "--jobs", o->jobs,
          "Scenes evaluated concurrently (results identical; per-stage times are then not representative)")
       ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  cmd->add_option("--view-points", o->view_points,
+                  "Cloud points in each scene's 3-D page (views/NAME.html); 0 = write no pages")
       ->capture_default_str();
   cmd->add_option("--pictures-per-count", o->pictures_per_count,
                   "Top-down pictures per tube count (the worst and a typical scene)")

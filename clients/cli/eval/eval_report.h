@@ -40,6 +40,8 @@ struct EvaluatedScene {
   std::uint64_t input_points = 0;
   SceneEvaluation evaluation;
   SceneSnapshot snapshot;
+  /// Its 3-D page relative to the report directory ("views/n10_s10005.html"); empty = none written.
+  std::string view_file;
 };
 
 /// One `tubepick eval` run.

@@ -91,6 +91,7 @@ json SceneJson(const EvaluatedScene& s) {
   confusion["counts"] = rows;
   return json{{"name", s.name},
               {"source", s.source},
+              {"view", s.view_file.empty() ? json(nullptr) : json(s.view_file)},
               {"tube_count", s.tube_count},
               {"scene_seed", s.scene_seed >= 0 ? json(s.scene_seed) : json(nullptr)},
               {"input_points", s.input_points},

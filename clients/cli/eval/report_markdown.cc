@@ -38,6 +38,11 @@ std::string FormatMarkdownReport(const EvalRun& run, const std::vector<ReportIma
   std::string md = "# Tube modeling evaluation\n\n";
   md += fmt::format("- Command: `{}`\n", run.command_line);
   md += fmt::format("- Scenes: {} ({})\n", all.scenes, run.source);
+  if (!run.scenes.empty() && !run.scenes.front().view_file.empty()) {
+    md +=
+        "- 3-D pages: `views/SCENE.html`, one per scene (its cloud and modeled tubes; open in a browser, "
+        "no network needed); the scene names below link them\n";
+  }
   md += fmt::format("- Modeling: profile `{}`{}, joining `{}`, modeling seed {}\n", run.profile,
                     run.params_path.empty() ? "" : fmt::format(" + `{}`", run.params_path),
                     run.joining_strategy, run.modeling_seed);
@@ -181,7 +186,8 @@ std::string FormatMarkdownReport(const EvalRun& run, const std::vector<ReportIma
     for (std::size_t k = 0; k < failing.size() && k < kMaxRows; ++k) {
       const EvaluatedScene& s = *failing[k];
       const SceneEvaluation& e = s.evaluation;
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} | {} / {} | {} |\n", s.name, s.tube_count,
+      const std::string name = s.view_file.empty() ? s.name : fmt::format("[{}]({})", s.name, s.view_file);
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.3f} | {} / {} | {} |\n", name, s.tube_count,
                         e.correct, e.partially_correct, Failures(e).empty() ? "0" : Failures(e), e.hidden,
                         e.micro_recall(), e.segments, e.visible_sections, e.virtual_tubes.size());
     }

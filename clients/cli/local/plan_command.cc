@@ -42,15 +42,9 @@ void Run(const PlanOptions& o) {
   const CellConfig cell = LoadCell(common);
   const Params params = LoadParamsFor(common);
   const CloudInput cloud = LoadCloudInput(o.input, cell);
-  const ModelingInput input = MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, common.seed,
-                                                RawRegionForPlanning(params.planning, cell.bin));
-  const ModelingResult modeling = ModelTubes(input, params.modeling);
-
-  physics::BulletTrajectoryEvaluator evaluator(physics::SimParamsForCell(
-      {}, cell, params.planning.cost.max_displacement, static_cast<int>(o.sim_threads)));
-  PickPlanResult plan =
-      PlanPick(modeling, cell, params.planning, o.no_sim ? nullptr : &evaluator, common.seed);
-  AttachPlacements(modeling, cell.place.X_BinPlace, params.placement, &plan);
+  const InProcessPlan planned = PlanInProcess(cloud, cell, params, common.seed, o.no_sim, o.sim_threads);
+  const ModelingResult& modeling = planned.modeling;
+  const PickPlanResult& plan = planned.plan;
 
   fmt::print("{}, profile {}, seed {}\n", cloud.source, common.profile, common.seed);
   fmt::print("modeling {:.3f} s: {} tubes; planning {:.3f} s: {} plans{}{}\n", modeling.total_seconds,
@@ -76,6 +70,18 @@ void Run(const PlanOptions& o) {
 }
 
 }  // namespace
+
+InProcessPlan PlanInProcess(const CloudInput& cloud, const CellConfig& cell, const Params& params,
+                            std::uint64_t seed, bool no_sim, std::uint32_t sim_threads) {
+  const ModelingInput input = MakeModelingInput(cloud.points_Sensor, cloud.unit, cell, seed,
+                                                RawRegionForPlanning(params.planning, cell.bin));
+  InProcessPlan out{ModelTubes(input, params.modeling), {}};
+  physics::BulletTrajectoryEvaluator evaluator(physics::SimParamsForCell(
+      {}, cell, params.planning.cost.max_displacement, static_cast<int>(sim_threads)));
+  out.plan = PlanPick(out.modeling, cell, params.planning, no_sim ? nullptr : &evaluator, seed);
+  AttachPlacements(out.modeling, cell.place.X_BinPlace, params.placement, &out.plan);
+  return out;
+}
 
 void AddPlanCommand(CLI::App& app) {
   auto o = std::make_shared<PlanOptions>();

@@ -1,0 +1,128 @@
+#include "clients/cli/cell/round_view.h"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+
+#include "clients/cli/inputs/cli_inputs.h"
+#include "core/common/errors.h"
+#include "wire/proto_convert.h"
+
+namespace tubepick::cli {
+namespace {
+
+// The cell a request describes (the controller always sends its own; its sensor pose is the scan's).
+CellConfig CellOf(const v1::CellDescription& d, const CellConfig& fallback) {
+  CellConfig cell = fallback;
+  if (d.has_bin_inner_size()) cell.bin.inner_size = FromProto(d.bin_inner_size(), "cell.bin_inner_size");
+  if (d.has_sensor_pose()) cell.sensor.X_BinSensor = FromProto(d.sensor_pose(), "cell.sensor_pose");
+  if (d.has_place_pose()) cell.place.X_BinPlace = FromProto(d.place_pose(), "cell.place_pose");
+  if (d.tube_radius() > 0) cell.tube.radius = d.tube_radius();
+  if (d.tube_length() > 0) cell.tube.length = d.tube_length();
+  if (d.tube_mass() > 0) cell.tube.mass = d.tube_mass();
+  return cell;
+}
+
+std::string AttemptNote(const nlohmann::json& r) {
+  std::string note = fmt::format(
+      "attempt {}: plan #{} (tube {}, {}) → {}", r.value("attempt", 0), r.value("plan_rank", 0) + 1,
+      r.value("tube", 0), r.value("trajectory_kind", std::string("-")), r.value("result", std::string("-")));
+  if (r.contains("analysis") && r["analysis"].is_object() && r["analysis"].contains("outcome"))
+    note += fmt::format(", lifted: {}", r["analysis"]["outcome"].get<std::string>());
+  if (r.contains("resolution") && r["resolution"].is_object() && r["resolution"].value("used", 0) > 0)
+    note += fmt::format(", resolution rotation {}",
+                        r["resolution"].value("succeeded", false) ? "freed it" : "tried");
+  if (r.contains("skipped_plans") && r["skipped_plans"].is_array() && !r["skipped_plans"].empty())
+    note += fmt::format(", {} plan(s) skipped by the cell's checks", r["skipped_plans"].size());
+  return note;
+}
+
+}  // namespace
+
+RoundViewRecorder::RoundViewRecorder(cell::PlannerClient& planner, cell::RecordSink& next,
+                                     std::string directory, std::size_t max_points, ToolParams tool)
+    : planner_(planner), next_(next), directory_(std::move(directory)), max_points_(max_points), tool_(tool) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory_, ec);
+  if (ec)
+    throw InvalidArgument(
+        fmt::format("--view {}: cannot create the directory: {}", directory_, ec.message()));
+}
+
+viewer::ViewFrame RoundViewRecorder::FrameOf(const v1::PlanPickRequest& request) {
+  cell_ = CellOf(request.cell(), cell_);
+  viewer::ViewFrame frame;
+  frame.label = fmt::format("scan {}", frames_.size() + 1);
+  const LengthUnit unit =
+      request.cloud().unit() == v1::LENGTH_UNIT_MILLIMETRE ? LengthUnit::kMillimetre : cell_.sensor.unit;
+  frame.cloud =
+      viewer::ThinToBin(PackedXyz{request.cloud().xyz()}, unit, cell_.sensor.X_BinSensor, max_points_);
+  return frame;
+}
+
+v1::PlanPickResponse RoundViewRecorder::PlanPick(const v1::PlanPickRequest& request,
+                                                 std::chrono::milliseconds deadline) {
+  viewer::ViewFrame frame = FrameOf(request);
+  try {
+    v1::PlanPickResponse response = planner_.PlanPick(request, deadline);
+    frame.plan = response;
+    if (response.bin_empty()) frame.note = "the planner saw the bin empty";
+    frames_.push_back(std::move(frame));
+    return response;
+  } catch (const cell::PlannerError& e) {
+    frame.error = e.what();
+    frames_.push_back(std::move(frame));
+    throw;
+  }
+}
+
+v1::AnalyzeWrenchResponse RoundViewRecorder::AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
+                                                           std::chrono::milliseconds deadline) {
+  return planner_.AnalyzeWrench(request, deadline);
+}
+
+void RoundViewRecorder::Annotate(const nlohmann::json& record) {
+  if (frames_.empty()) return;
+  viewer::ViewFrame& last = frames_.back();
+  const std::string type = record.value("type", std::string());
+  if (type == "attempt") {
+    if (record.contains("plan_rank") && record["plan_rank"].is_number())
+      last.chosen_plan = record["plan_rank"].get<int>();
+    last.note = AttemptNote(record);
+  } else if (type == "safe_stop") {
+    last.note += (last.note.empty() ? "" : "; ") + fmt::format("safe stop ({}): {}",
+                                                               record.value("reason", std::string("-")),
+                                                               record.value("message", std::string("-")));
+  }
+}
+
+void RoundViewRecorder::WriteRound(const nlohmann::json& end) {
+  const std::uint32_t round = end.value("round", 0u);
+  viewer::ViewPage page;
+  page.title = fmt::format("tubepick cell: round {}", round);
+  page.source = fmt::format("tubepick cell, round {}: {}", round, end.value("message", std::string()));
+  page.cell = cell_;
+  page.tool = tool_;
+  page.frames = std::move(frames_);
+  frames_.clear();
+  if (page.frames.empty()) {
+    viewer::ViewFrame none;
+    none.label = "no scan";
+    none.error = end.value("message", std::string("the round ended before its first plan"));
+    page.frames.push_back(std::move(none));
+  }
+  const std::string path =
+      (std::filesystem::path(directory_) / fmt::format("round_{:03d}.html", round)).string();
+  WriteTextFile(path, viewer::PageHtml(page));
+  pages_.push_back(path);
+}
+
+void RoundViewRecorder::Write(const nlohmann::json& record) {
+  next_.Write(record);
+  if (record.value("type", std::string()) == "end")
+    WriteRound(record);
+  else
+    Annotate(record);
+}
+
+}  // namespace tubepick::cli
