@@ -7,5 +7,5 @@ if(TARGET tubepick-server)
   add_test(NAME smoke
     COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/smoke.sh $<TARGET_FILE:tubepick-server> $<TARGET_FILE:tubepick>)
   # Binds only 127.0.0.1:0 ports, so it may run beside other tests.
-  set_tests_properties(smoke PROPERTIES TIMEOUT 600)
+  set_tests_properties(smoke PROPERTIES TIMEOUT 600 COST 100)  # started early (see viewer.cmake)
 endif()
