@@ -1,20 +1,23 @@
 // Boot: read the embedded data, build the layout, 3-D view and panel, expose window.tubepickViewer.
 import { injectStyle } from './style.js';
 import { el } from './dom.js';
-import { parseData, frameModel, num } from './data.js';
-import { createView, frameBox, boxOf } from './scene.js';
+import { parseData, frameModel, num, vec3 } from './data.js';
+import { createView, boxOf, screenPoint } from './scene.js';
+import { applyPreset, presetBar, presetByKey } from './views.js';
 import { buildBin, buildPlacement } from './cell.js';
 import { gripperDims } from './gripper.js';
 import { colourCloud, HEIGHT_STOPS, labelledCount } from './cloud.js';
 import { styleTubes } from './tubes.js';
 import { buildFrameObjects, showPlan, clearPlan, dispose } from './frame.js';
 import { pickTube, screenPointOfTube } from './picking.js';
+import { createHover } from './hover.js';
+import { renderPlanDetails } from './details.js';
 import { buildHeader, buildStepper, buildControls, buildFrameSection, markSelection, legend, LAYERS } from './panel.js';
 import { createPlayerBar } from './playerbar.js';
 
 const state = {
   ready: false, errors: [], data: null, models: [], frameIndex: 0, model: null, objs: null,
-  selectedPlan: null, selectedTubeId: null, hoverId: null, ghost: false,
+  selectedPlan: null, selectedTubeId: null, hoverId: null, ghost: false, cameraPreset: null,
   layers: Object.fromEntries(LAYERS.map((l) => [l, true])), colourMode: 'height', pointSize: 3, byOcclusion: false,
 };
 const ui = {};
@@ -39,7 +42,8 @@ function layout() {
   ui.legend = el('div', { id: 'legend', class: 'overlay' });
   ui.tooltip = el('div', { id: 'tooltip' });
   ui.banner = el('div', { id: 'banner' });
-  ui.viewEl = el('div', { id: 'view' }, ui.legend, ui.tooltip, ui.banner, ui.message);
+  ui.presets = presetBar((name) => setCameraPreset(name));
+  ui.viewEl = el('div', { id: 'view' }, ui.legend, ui.presets, ui.tooltip, ui.banner, ui.message);
   ui.panel = el('aside', { id: 'panel' });
   document.body.append(el('div', { id: 'app' }, ui.viewEl, ui.panel));
 }
@@ -70,6 +74,7 @@ function showFrame(i) {
   banner();
   state.selectedPlan = null; state.selectedTubeId = null;
   recolourCloud();
+  ui.hover.leave();
   const chosen = state.model.chosenPlan;
   selectPlan(chosen != null && state.model.plans[chosen] ? chosen : state.model.plans.length ? 0 : null);
 }
@@ -82,6 +87,7 @@ function recolourCloud() {
 
 function selectPlan(i) {
   const plan = i == null ? null : state.model?.plans[Number(i)];
+  renderPlanDetails(ui.panel, state.model, plan);
   if (!plan) { state.selectedPlan = null; clearPlan(state.objs); ui.bar.setPlayer(null); refresh(); return; }
   state.selectedPlan = plan.index;
   state.selectedTubeId = plan.tubeId;
@@ -163,26 +169,24 @@ function installPointer() {
     const id = pickTube(ui.view, state.objs?.tubes, e.clientX, e.clientY);
     if (id != null) selectTube(id);
   });
-  canvas.addEventListener('pointermove', (e) => { if (!e.buttons) hover(e); });
-  canvas.addEventListener('pointerleave', () => setHover(null));
+  canvas.addEventListener('pointermove', (e) => { if (!e.buttons) ui.hover.move(e); });
+  canvas.addEventListener('pointerleave', () => ui.hover.leave());
 }
 
-function hover(e) {
-  const id = pickTube(ui.view, state.objs?.tubes, e.clientX, e.clientY);
-  setHover(id);
-  if (id == null) return;
-  const t = state.model.tubes.find((x) => x.id === id);
-  const best = state.model.plans.find((p) => p.tubeId === id);
-  const r = ui.viewEl.getBoundingClientRect();
-  ui.tooltip.textContent = `tube ${id} · ${t.occlusion} occlusion · ${t.length.toFixed(3)} m · ${best ? `best plan #${best.index + 1} (G ${best.cost.G.toFixed(3)})` : 'no plan'}`;
-  ui.tooltip.style.left = `${e.clientX - r.left + 14}px`;
-  ui.tooltip.style.top = `${e.clientY - r.top + 14}px`;
-}
-
-function setHover(id) {
-  ui.tooltip.style.display = id == null ? 'none' : 'block';
-  ui.view.renderer.domElement.style.cursor = id == null ? '' : 'pointer';
+function setHoverTube(id) {
   if (id !== state.hoverId) { state.hoverId = id; refresh(); }
+}
+
+/** Camera preset '3/4' | 'top' | 'front' | 'side', framing the bin and the placement frame. */
+function setCameraPreset(name) {
+  applyPreset(ui.view, name, ui.frameBox, ui.binBox);
+  state.cameraPreset = name;
+  ui.presets.setActive(name);
+}
+
+function onUserCamera() {
+  state.cameraPreset = null;
+  ui.presets.setActive(null);
 }
 
 function installKeys() {
@@ -191,7 +195,9 @@ function installKeys() {
     if (e.key === 'ArrowLeft') showFrame(state.frameIndex - 1);
     else if (e.key === 'ArrowRight') showFrame(state.frameIndex + 1);
     else if (e.key === 'Escape') selectTube(null);
-    else if (e.key === ' ') { ui.bar.toggle(); e.preventDefault(); } else return;
+    else if (e.key === ' ') { ui.bar.toggle(); e.preventDefault(); } else if (presetByKey(e.key) && !e.ctrlKey && !e.metaKey && !e.altKey) {
+      setCameraPreset(presetByKey(e.key).name);
+    }
   });
 }
 
@@ -202,7 +208,7 @@ function buildPanel() {
   ui.panel.append(buildHeader(d), ui.stepper || el('div', { class: 'meta', style: 'margin-top:8px' }, d.frames[0].label || ''),
     ui.frameSection, el('h2', {}, 'Display'), buildControls(state, handlers),
     el('div', { class: 'hint' }, 'drag: orbit · right-drag: pan · wheel: zoom · click a tube or a row to select · ',
-      el('kbd', {}, 'Esc'), ' clear · ', el('kbd', {}, 'space'), ' play', d.frames.length > 1 ? [' · ', el('kbd', {}, '←'), el('kbd', {}, '→'), ' frames'] : ''));
+      el('kbd', {}, 'Esc'), ' clear · ', el('kbd', {}, 'space'), ' play · ', el('kbd', {}, '1'), '–', el('kbd', {}, '4'), ' views', d.frames.length > 1 ? [' · ', el('kbd', {}, '←'), el('kbd', {}, '→'), ' frames'] : ''));
 }
 
 function buildCell() {
@@ -212,7 +218,10 @@ function buildCell() {
   ui.binHeight = ui.bin.userData.size[2];
   ui.placement = buildPlacement(cell.X_BinPlace);
   ui.view.scene.add(ui.bin, ui.placement);
-  frameBox(ui.view, boxOf([ui.bin, ui.placement]), boxOf([ui.bin]));
+  ui.frameBox = boxOf([ui.bin, ui.placement]);
+  ui.binBox = boxOf([ui.bin]);
+  setCameraPreset('3/4');
+  ui.view.controls.addEventListener('start', onUserCamera);
 }
 
 function boot() {
@@ -231,6 +240,7 @@ function boot() {
     ui.view = createView(ui.viewEl);
     ui.bar = createPlayerBar(ui.viewEl, () => ui.view.requestRender());
     ui.view.onFrame.push((t) => ui.bar.tick(t));
+    ui.hover = createHover(ui, state, setHoverTube);
     buildCell();
     buildPanel();
     installPointer();
@@ -250,7 +260,10 @@ window.tubepickViewer = {
   get selectedPlan() { return state.selectedPlan; },
   get selectedTubeId() { return state.selectedTubeId; },
   get colourMode() { return state.colourMode; },
-  showFrame, selectPlan, selectTube, setColourMode,
+  get cameraPreset() { return state.cameraPreset; },
+  showFrame, selectPlan, selectTube, setColourMode, setCameraPreset,
+  camera: () => ({ position: ui.view.camera.position.toArray(), target: ui.view.controls.target.toArray() }),
+  screenPoint: (p) => screenPoint(ui.view, vec3(p)),
   tubeCount: () => state.model?.tubes.length || 0,
   planCount: () => state.model?.plans.length || 0,
   screenPointOfTube: (id) => screenPointOfTube(ui.view, state.objs?.tubes, state.model?.tubes.find((t) => t.id === num(id))),

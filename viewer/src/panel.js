@@ -46,6 +46,7 @@ export function buildFrameSection(m, h) {
     m.problems.map((p) => el('div', { class: 'frame-error data-problem' }, p)),
     el('h2', {}, 'Summary'), summary(m),
     el('h2', {}, `Tubes (${m.tubes.length})`), tubesTable(m, h),
+    m.plans.length ? [el('h2', {}, 'Selected plan'), el('div', { id: 'plan-details', class: 'plan-details' })] : null,
     el('h2', {}, `Plans (${m.plans.length})`), plansTable(m, h),
     countsSection(m), timingsSection(m));
 }

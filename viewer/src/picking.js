@@ -4,15 +4,30 @@ import { screenPoint } from './scene.js';
 import { tubeCentre } from './tubes.js';
 
 const raycaster = new Raycaster();
+raycaster.params.Points.threshold = 0.004; // m: a cloud point within 4 mm of the ray is hit
+
+function aim(view, clientX, clientY) {
+  const r = view.renderer.domElement.getBoundingClientRect();
+  const ndc = new Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, view.camera);
+}
 
 /** Tube id under a page CSS pixel, or null. */
 export function pickTube(view, tubesGroup, clientX, clientY) {
   if (!tubesGroup || !tubesGroup.visible) return null;
-  const r = view.renderer.domElement.getBoundingClientRect();
-  const ndc = new Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
-  raycaster.setFromCamera(ndc, view.camera);
+  aim(view, clientX, clientY);
   const hit = raycaster.intersectObjects(tubesGroup.children, true).find((h) => h.object.userData.tubeId != null);
   return hit ? hit.object.userData.tubeId : null;
+}
+
+/** Nearest cloud point along the ray under a page CSS pixel: {index, p: Vector3 (bin frame)}, or null. */
+export function pickCloudPoint(view, cloud, clientX, clientY) {
+  if (!cloud || !cloud.visible) return null;
+  aim(view, clientX, clientY);
+  const hit = raycaster.intersectObject(cloud, false)[0];
+  if (!hit) return null;
+  const a = cloud.userData.xyz, i = hit.index;
+  return { index: i, p: new Vector3(a[3 * i], a[3 * i + 1], a[3 * i + 2]) };
 }
 
 function insideCanvas(view, s) {

@@ -1,7 +1,7 @@
 // three.js renderer, camera, orbit controls, lights and an on-demand render loop.
 import {
   WebGLRenderer, Scene, PerspectiveCamera, Color, AmbientLight, DirectionalLight,
-  HemisphereLight, Vector3, Group, Box3, GridHelper,
+  HemisphereLight, Group, Box3, GridHelper,
 } from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
@@ -78,18 +78,6 @@ function makeLoop(view) {
     if (!pending) { pending = true; requestAnimationFrame(tick); }
   };
   return request;
-}
-
-/** Frame the camera on a box (bin plus placement) from a 3/4 view, centred towards focus (the bin). */
-export function frameBox(view, box, focus = box) {
-  const centre = focus.getCenter(new Vector3()).lerp(box.getCenter(new Vector3()), 0.35);
-  const radius = Math.max(box.getSize(new Vector3()).length() / 2, 0.1);
-  const dist = (radius / Math.sin((view.camera.fov * Math.PI) / 360)) * 0.95;
-  const dir = new Vector3(0.55, -1.0, 0.95).normalize();
-  view.camera.position.copy(centre).addScaledVector(dir, dist);
-  view.controls.target.copy(centre);
-  view.controls.update();
-  view.requestRender();
 }
 
 export function boxOf(objects) {

@@ -66,6 +66,26 @@ input[type=range] { accent-color:var(--accent); width:100%; }
 #banner { position:absolute; top:10px; left:50%; transform:translateX(-50%); max-width:60%; display:none; background:rgba(58,29,31,.95);
   border:1px solid var(--bad); color:#ffd0ce; padding:6px 14px; border-radius:6px; font-weight:600; white-space:pre-wrap; }
 #banner.show { display:block; }
+#view-presets { top:10px; right:10px; display:flex; align-items:center; gap:4px; padding:5px 6px; }
+#view-presets .presets-label { color:var(--muted); font-size:10px; letter-spacing:.08em; text-transform:uppercase; margin:0 4px 0 3px; }
+#view-presets button { min-width:44px; padding:3px 8px; font-size:12px; }
+#view-presets button.active { background:var(--sel); border-color:var(--sel-line); color:#fff; }
+.tip-muted { color:var(--muted); }
+.plan-details { background:#212733; border:1px solid var(--line); border-radius:7px; padding:9px 11px; font-variant-numeric:tabular-nums; }
+.plan-details .empty { padding:0; }
+.pd-head { display:flex; align-items:center; gap:8px; margin-bottom:7px; padding-bottom:7px; border-bottom:1px solid var(--line); }
+.pd-rank { font-size:15px; font-weight:700; }
+.pd-head .meta { margin-right:auto; margin-left:-3px; }
+.pd-tube { font-weight:600; }
+.badge.kind { background:#16303a; color:#7dd3fc; }
+.pd-grid { display:grid; grid-template-columns:auto 1fr; gap:4px 14px; font-size:12px; }
+.pd-grid .k { color:var(--muted); white-space:nowrap; }
+.pd-grid .v { text-align:right; }
+.pd-grid b { font-weight:600; }
+.xyz > span, .costs > span { display:inline-block; min-width:62px; }
+.xyz i, .costs i, .wp { font-style:normal; color:var(--muted); margin-right:4px; font-size:11px; }
+.xyz > i { margin:0 0 0 4px; }
+.costs .total b { color:#8cc2ff; }
 .hint { color:var(--muted); font-size:11px; margin-top:10px; }
 kbd { background:#252c37; border:1px solid #3a4352; border-radius:3px; padding:0 4px; font-size:11px; }
 `;

@@ -31,23 +31,53 @@ async function fetchText(url) {
 const num = (v) => (Number.isFinite(Number(v)) ? Number(v) : 0);
 const nonEmpty = (a) => (Array.isArray(a) && a.length ? a : null);
 
-/** Expected per-frame counts, computed independently from the page's embedded JSON. */
-function expectedFrames(html) {
+function pageData(html) {
   const m = html.match(/<script type="application\/json" id="tubepick-data">([\s\S]*?)<\/script>/);
   if (!m) throw new Error('no <script type="application/json" id="tubepick-data"> in the page');
-  const data = JSON.parse(m[1]);
+  return JSON.parse(m[1]);
+}
+
+/** Expected per-frame counts and grasp positions, computed independently from the page's embedded JSON. */
+function expectedFrames(data) {
   return data.frames.map((f) => {
     const tubes = f.plan ? nonEmpty(f.plan.tubes) || nonEmpty(f.plan.modeling?.tubes) || [] : nonEmpty(f.modeling?.tubes) || [];
     const plans = Array.isArray(f.plan?.plans) ? f.plan.plans : [];
-    return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)) };
+    const grasp = (p) => ['x', 'y', 'z'].map((k) => num(p.grasp?.tcpPose?.position?.[k]));
+    return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)), grasps: plans.map(grasp) };
   });
 }
+
+/** Bin inner size [L, W, H] (viewer default when absent). */
+const binSize = (data) => (data.cell?.bin?.inner_size || [0.8, 0.6, 0.2]).map(num);
 
 const api = (page, expr) => page.evaluate(`(() => { const v = window.tubepickViewer; return ${expr}; })()`);
 const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 
+const canvasPng = (page) => page.locator('#view canvas').screenshot();
+
+/** Percentage of pixels whose RGB differs by more than 24 (sum of abs) between two PNGs of equal size. */
+async function pixelDiff(page, a, b) {
+  return page.evaluate(async ([ba, bb]) => {
+    const load = async (b64) => {
+      const img = new Image();
+      img.src = `data:image/png;base64,${b64}`;
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = img.width; c.height = img.height;
+      const ctx = c.getContext('2d', { willReadFrequently: true });
+      ctx.drawImage(img, 0, 0);
+      return ctx.getImageData(0, 0, c.width, c.height).data;
+    };
+    const [da, db] = [await load(ba), await load(bb)];
+    if (da.length !== db.length) return 100;
+    let n = 0;
+    for (let i = 0; i < da.length; i += 4) if (Math.abs(da[i] - db[i]) + Math.abs(da[i + 1] - db[i + 1]) + Math.abs(da[i + 2] - db[i + 2]) > 24) n++;
+    return (100 * n) / (da.length / 4);
+  }, [a.toString('base64'), b.toString('base64')]);
+}
+
 async function checkCanvas(page) {
-  const png = await page.locator('#view canvas').screenshot();
+  const png = await canvasPng(page);
   const stats = await page.evaluate(async ({ b64, bg }) => {
     const img = new Image();
     img.src = `data:image/png;base64,${b64}`;
@@ -82,6 +112,17 @@ async function checkPlanClick(page, f, k) {
   const planCls = await rowClass(page, `#plans tr[data-plan-index="${k}"]`);
   check(sp === k && st === want && /\bselected\b/.test(cls || '') && /\bselected\b/.test(planCls || ''),
     `  click plan row ${k}`, `selectedPlan=${sp} selectedTubeId=${st} (want ${k}, ${want}); tube row class "${cls}"`);
+  await checkPlanDetails(page, f, k);
+}
+
+const GRASP_TOL = 0.0005; // m: the box shows 3 decimals
+
+async function checkPlanDetails(page, f, k) {
+  const shown = await page.evaluate(() => ['x', 'y', 'z'].map((a) => document.querySelector(`#plan-details [data-field="grasp-${a}"]`)?.textContent ?? null));
+  const want = f.grasps[k];
+  const err = Math.max(...shown.map((t, i) => (t == null ? Infinity : Math.abs(Number(t) - want[i]))));
+  check(err <= GRASP_TOL, `  plan ${k} details: grasp x/y/z`,
+    `shown (${shown.join(', ')}) vs JSON (${want.map((v) => v.toFixed(4)).join(', ')}), max error ${Number.isFinite(err) ? err.toFixed(5) : 'missing'} m (≤ ${GRASP_TOL})`);
 }
 
 async function checkTubeClick(page, f, id) {
@@ -127,6 +168,82 @@ async function checkFrame(page, f, i) {
   if (nt) await checkCanvasPick(page, np ? f.planTubeIds[0] : f.tubeIds[0]);
 }
 
+const PRESETS = ['top', 'front', 'side', '3/4'];
+const PRESET_DIFF = 5; // % of canvas pixels that must change between consecutive presets
+
+const camera = (page) => api(page, 'v.camera()');
+const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+
+async function checkTopView(page, [L, W, H]) {
+  const { position: p, target: t } = await camera(page);
+  const d = [t[0] - p[0], t[1] - p[1], t[2] - p[2]];
+  const down = d[2] / Math.hypot(...d);
+  check(p[2] > H && Math.abs(p[0]) <= L / 4 && Math.abs(p[1]) <= W / 4 && down < -0.999, '  preset top: camera above the bin',
+    `camera (${p.map((v) => v.toFixed(3)).join(', ')}) m: z > wall height ${H}, |x| ≤ ${L / 4}, |y| ≤ ${W / 4}; view direction z ${down.toFixed(4)} (< −0.999)`);
+}
+
+/** Preset buttons: each changes the canvas; top looks straight down at the bin; keys and orbiting afterwards work. */
+async function checkPresets(page, bin) {
+  await page.mouse.move(1590, 890); // off the canvas: no hover tooltip or marker in the screenshots
+  const boot = await camera(page);
+  const first = await api(page, 'v.cameraPreset');
+  check(first === '3/4', 'camera preset at boot', `cameraPreset=${first}`);
+  let prev = await canvasPng(page);
+  for (const name of PRESETS) {
+    await page.locator(`#view-presets button[data-preset="${name}"]`).click();
+    await settle(page);
+    const png = await canvasPng(page);
+    const diff = await pixelDiff(page, prev, png);
+    const [now, cls] = [await api(page, 'v.cameraPreset'), await rowClass(page, `#view-presets button[data-preset="${name}"]`)];
+    check(now === name && /\bactive\b/.test(cls || '') && diff >= PRESET_DIFF, `  preset ${name}`,
+      `cameraPreset=${now}, button class "${cls}", ${diff.toFixed(1)} % of pixels changed (need ≥ ${PRESET_DIFF} %)`);
+    if (name === 'top') await checkTopView(page, bin);
+    prev = png;
+  }
+  const back = dist((await camera(page)).position, boot.position);
+  check(back < 1e-6, '  preset 3/4 restores the boot framing', `camera ${back.toExponential(1)} m from the boot position`);
+  await checkPresetKeysAndOrbit(page);
+}
+
+async function checkPresetKeysAndOrbit(page) {
+  await page.keyboard.press('2');
+  const key = await api(page, 'v.cameraPreset');
+  const before = (await camera(page)).position;
+  const box = await page.locator('#view canvas').boundingBox();
+  const [x, y] = [box.x + box.width * 0.5, box.y + box.height * 0.85];
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  await page.mouse.move(x + 120, y - 40, { steps: 6 });
+  await page.mouse.up();
+  await settle(page);
+  const moved = dist((await camera(page)).position, before);
+  const after = await api(page, 'v.cameraPreset');
+  check(key === 'top' && moved > 0.05 && after === null, '  key 2 → top, then orbit by mouse drag',
+    `cameraPreset after key ${key}; drag moved the camera ${moved.toFixed(3)} m (> 0.05), cameraPreset then ${after}`);
+  await page.keyboard.press('1');
+  check(await api(page, 'v.cameraPreset') === '3/4', '  key 1 → 3/4', `cameraPreset=${await api(page, 'v.cameraPreset')}`);
+}
+
+/** Hover the cloud on a grid until the tooltip shows a point; that point must project under the mouse. */
+async function checkCloudHover(page) {
+  const box = await page.locator('#view canvas').boundingBox();
+  for (let i = 0; i < 25; i++) {
+    const x = box.x + box.width * (0.3 + 0.1 * (i % 5)), y = box.y + box.height * (0.3 + 0.1 * Math.floor(i / 5));
+    await page.mouse.move(x, y);
+    await page.waitForTimeout(90);
+    const tip = await page.evaluate(() => { const t = document.getElementById('tooltip'); return { point: t.dataset.point, text: t.textContent, shown: t.style.display }; });
+    if (!tip.point) continue;
+    const p = tip.point.split(',').map(Number);
+    const s = await api(page, `v.screenPoint(${JSON.stringify(p)})`);
+    const off = Math.hypot(s.x - x, s.y - y);
+    check(off <= 8 && tip.shown === 'block' && /x -?\d+\.\d{3}/.test(tip.text), 'cloud hover: point coordinates in the tooltip',
+      `mouse (${x.toFixed(0)}, ${y.toFixed(0)}) → "${tip.text}"; the point projects ${off.toFixed(1)} px from the mouse (≤ 8)`);
+    await page.mouse.move(1590, 890);
+    return;
+  }
+  check(false, 'cloud hover: point coordinates in the tooltip', 'no cloud point found under 25 grid positions');
+}
+
 async function exercise(page, frames) {
   for (const m of ['segment', 'tube', 'height']) await api(page, `v.setColourMode('${m}')`);
   await settle(page);
@@ -147,7 +264,8 @@ async function exercise(page, frames) {
 }
 
 async function checkViewerPage(page, url, consoleErrors) {
-  const frames = expectedFrames(await fetchText(url));
+  const data = pageData(await fetchText(url));
+  const frames = expectedFrames(data);
   if (page.url() !== url) await page.goto(url, { waitUntil: 'load' });
   const t0 = Date.now();
   const ready = await page.waitForFunction(() => window.tubepickViewer && window.tubepickViewer.ready === true, null, { timeout: 20000 })
@@ -162,6 +280,8 @@ async function checkViewerPage(page, url, consoleErrors) {
   if (check(canvases === 1, 'WebGL canvas in #view', `${canvases} canvas element(s)`)) {
     await settle(page);
     await checkCanvas(page);
+    await checkPresets(page, binSize(data));
+    if (data.frames[0]?.cloud?.xyz) await checkCloudHover(page);
     for (let i = 0; i < frames.length; i++) await checkFrame(page, frames[i], i);
     await exercise(page, frames);
   }
