@@ -55,10 +55,10 @@ const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimation
 
 const canvasPng = (page) => page.locator('#view canvas').screenshot();
 
-/** Percentage of pixels whose RGB differs by more than 24 (sum of abs) between two PNGs of equal size. */
-async function pixelDiff(page, a, b) {
-  return page.evaluate(async ([ba, bb]) => {
-    const load = async (b64) => {
+/** Defines window.__checkPixels(b64) in the page: the RGBA bytes of a PNG, decoded by the browser itself. */
+async function installPixelDecoder(page) {
+  await page.evaluate(() => {
+    window.__checkPixels = async (b64) => {
       const img = new Image();
       img.src = `data:image/png;base64,${b64}`;
       await img.decode();
@@ -66,9 +66,16 @@ async function pixelDiff(page, a, b) {
       c.width = img.width; c.height = img.height;
       const ctx = c.getContext('2d', { willReadFrequently: true });
       ctx.drawImage(img, 0, 0);
-      return ctx.getImageData(0, 0, c.width, c.height).data;
+      return { data: ctx.getImageData(0, 0, c.width, c.height).data, width: c.width, height: c.height };
     };
-    const [da, db] = [await load(ba), await load(bb)];
+  });
+}
+
+/** Percentage of pixels whose RGB differs by more than 24 (sum of abs) between two PNGs of equal size. */
+async function pixelDiff(page, a, b) {
+  await installPixelDecoder(page);
+  return page.evaluate(async ([ba, bb]) => {
+    const [da, db] = [(await window.__checkPixels(ba)).data, (await window.__checkPixels(bb)).data];
     if (da.length !== db.length) return 100;
     let n = 0;
     for (let i = 0; i < da.length; i += 4) if (Math.abs(da[i] - db[i]) + Math.abs(da[i + 1] - db[i + 1]) + Math.abs(da[i + 2] - db[i + 2]) > 24) n++;
@@ -78,15 +85,10 @@ async function pixelDiff(page, a, b) {
 
 async function checkCanvas(page) {
   const png = await canvasPng(page);
+  await installPixelDecoder(page);
   const stats = await page.evaluate(async ({ b64, bg }) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = document.createElement('canvas');
-    c.width = img.width; c.height = img.height;
-    const ctx = c.getContext('2d', { willReadFrequently: true });
-    ctx.drawImage(img, 0, 0);
-    const d = ctx.getImageData(0, 0, c.width, c.height).data;
+    const c = await window.__checkPixels(b64);
+    const d = c.data;
     const colours = new Set();
     let differ = 0;
     for (let i = 0; i < d.length; i += 4) {
