@@ -36,8 +36,9 @@ struct HttpEndpointsOptions {
 ///   GET|HEAD /healthz                 200 SERVING / 503 NOT_SERVING
 ///   GET /debug/calls                  the kept calls, newest first (HTML; .json for JSON)
 ///   GET /debug/calls/ID               the 3-D viewer page of one call (.json: its page data)
-/// Other paths 404, other methods 405, request bodies over 4 KiB 413. A slow or broken client holds
-/// one of `threads` connections for at most io_timeout; it never blocks the gRPC side.
+/// Other paths 404, other methods 405, request bodies over 4 KiB 413. Answers are never compressed
+/// (no planning CPU for it). A slow or broken client holds one of `threads` connections for at most
+/// io_timeout; it never blocks the gRPC side.
 class HttpEndpoints {
  public:
   /// Binds and listens on `address` (HOST:PORT, port 0 = any free port) and starts serving.
