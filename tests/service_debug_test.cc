@@ -103,17 +103,14 @@ TEST(DebugCalls, TheLastCallsAreKeptWithTheirCloudResponseOrError) {
   const std::string viewer = Get(port, "/debug/calls/2", &status);
   EXPECT_EQ(status, 200);
   EXPECT_THAT(viewer, HasSubstr("<script type=\"application/json\" id=\"tubepick-data\">"));
-  // A browser accepts Brotli and gzip; the page still comes uncompressed, at once (the library would
-  // spend seconds of a planning core on Brotli).
-  const auto asked = std::chrono::steady_clock::now();
+  // A browser accepts Brotli and gzip; the page still comes uncompressed (the library would spend
+  // seconds of a planning core on Brotli: docs/SERVICE.md).
   const std::string page_answer = service_test::HttpExchange(
       port, "GET /debug/calls/2 HTTP/1.1\r\nHost: x\r\nAccept-Encoding: gzip, deflate, br\r\n\r\n");
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
   EXPECT_EQ(page_answer.rfind("HTTP/1.1 200 ", 0), 0u);
   EXPECT_THAT(page_answer.substr(0, page_answer.find("\r\n\r\n")),
               ::testing::Not(HasSubstr("Content-Encoding")));
   EXPECT_THAT(page_answer, HasSubstr("id=\"tubepick-data\">"));
-  EXPECT_LT(seconds, 2.0);
   EXPECT_EQ(Get(port, "/debug/calls/x", &status).empty(), false);
   EXPECT_EQ(status, 404);
 }
