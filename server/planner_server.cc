@@ -235,9 +235,10 @@ void PlannerServer::Shutdown(std::chrono::milliseconds grace) {
   }
   const auto started = std::chrono::steady_clock::now();
   spdlog::info("shutting down: {} calls in flight, grace {} ms", m.service->calls_in_flight(), grace.count());
-  // Load balancers and health probes see NOT_SERVING first.
-  m.server->GetHealthCheckService()->SetServingStatus(false);
+  // Load balancers and health probes see NOT_SERVING first: the HTTP probe's flag before gRPC's health
+  // status, so a client woken by a health watch never finds /healthz still SERVING.
   m.serving = false;
+  m.server->GetHealthCheckService()->SetServingStatus(false);
 
   // gRPC refuses new calls at once and cancels the remaining ones at the deadline (their OnCancel
   // stops the tokens). The watchdog also stops every token then, in case a call is between states.
