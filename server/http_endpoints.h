@@ -27,8 +27,9 @@ struct HttpEndpointsOptions {
   const DebugCallStore* debug_calls = nullptr;
   /// Budget of one request's reading and of one answer's writing.
   std::chrono::milliseconds io_timeout{2000};
-  /// Connections answered at once (the rest wait in the listen backlog).
-  int threads = 4;
+  /// Connections answered at once (the rest wait in the listen backlog): scrapes and probes are
+  /// seconds apart, and every thread is one more for the allocator's arenas.
+  int threads = 2;
 };
 
 /// The service's HTTP/1.1 side on cpp-httplib (Debian's libcpp-httplib):
