@@ -6,12 +6,6 @@
 namespace tubepick::server {
 namespace {
 
-std::string TimeText(std::chrono::system_clock::time_point t) {
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch()).count() % 1000;
-  return fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z", fmt::gmtime(std::chrono::system_clock::to_time_t(t)),
-                     ms);
-}
-
 std::string Label(const DebugCall& call) {
   return fmt::format("call {} · {} · {}", call.id, call.record.rpc, call.record.code);
 }
@@ -54,7 +48,7 @@ std::string DebugCallStore::ListHtml() const {
     rows += fmt::format(
         "<tr class=\"{}\"><td><a data-call-id=\"{}\" href=\"/debug/calls/{}\">call {}</a></td><td>{}</td>"
         "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.0f}</td><td>{}</td><td>{}</td></tr>\n",
-        r.code == "OK" ? "ok" : "failed", call->id, call->id, call->id, TimeText(call->finished),
+        r.code == "OK" ? "ok" : "failed", call->id, call->id, call->id, UtcText(call->finished),
         viewer::HtmlEscape(r.rpc), viewer::HtmlEscape(r.code), r.points, r.tubes, r.plans, r.total_ms,
         viewer::HtmlEscape(r.request_id), viewer::HtmlEscape(r.message));
   }
@@ -84,7 +78,7 @@ std::string DebugCallStore::ListJson() const {
         "\"message\":\"{}\",\"request_id\":\"{}\",\"points\":{},\"tubes\":{},\"plans\":{},\"total_ms\":{:.1f}"
         ","
         "\"has_cloud\":{}}}",
-        first ? "" : ",", call->id, call->id, TimeText(call->finished), JsonEscape(r.rpc), JsonEscape(r.code),
+        first ? "" : ",", call->id, call->id, UtcText(call->finished), JsonEscape(r.rpc), JsonEscape(r.code),
         JsonEscape(r.message), JsonEscape(r.request_id), r.points, r.tubes, r.plans, r.total_ms,
         call->capture && call->capture->frame.cloud ? "true" : "false");
     first = false;
@@ -97,7 +91,7 @@ viewer::ViewPage DebugCallStore::PageOf(const DebugCall& call) const {
   const CallRecord& r = call.record;
   page.title = fmt::format("tubepick call {}: {} {}", call.id, r.rpc, r.code);
   page.source = fmt::format("tubepick-server, call {} (request id {}, peer {}), finished {}", call.id,
-                            r.request_id, r.peer, TimeText(call.finished));
+                            r.request_id, r.peer, UtcText(call.finished));
   page.links.push_back({"all kept calls", "/debug/calls"});
   page.links.push_back({"this call as JSON", fmt::format("/debug/calls/{}.json", call.id)});
   viewer::ViewFrame frame;

@@ -20,6 +20,14 @@ std::string Ms(double ms) { return fmt::format("{:.1f}", ms); }
 
 }  // namespace
 
+std::string UtcText(std::chrono::system_clock::time_point time) {
+  const auto since_epoch = time.time_since_epoch();
+  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(since_epoch);
+  const auto millis = std::chrono::duration_cast<std::chrono::milliseconds>(since_epoch - seconds).count();
+  return fmt::format("{:%Y-%m-%dT%H:%M:%S}.{:03d}Z", fmt::gmtime(std::chrono::system_clock::to_time_t(time)),
+                     millis);
+}
+
 std::string JsonEscape(const std::string& text) {
   std::string out;
   out.reserve(text.size());
@@ -75,14 +83,10 @@ std::string FormatCallJson(const CallRecord& r) {
 }
 
 void JsonLineFormatter::format(const spdlog::details::log_msg& msg, spdlog::memory_buf_t& dest) {
-  const auto since_epoch = msg.time.time_since_epoch();
-  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(since_epoch);
-  const auto millis = std::chrono::duration_cast<std::chrono::milliseconds>(since_epoch - seconds).count();
   const std::string payload(msg.payload.data(), msg.payload.size());
   const spdlog::string_view_t level = spdlog::level::to_string_view(msg.level);
   auto out = std::back_inserter(dest);
-  fmt::format_to(out, R"({{"time":"{:%Y-%m-%dT%H:%M:%S}.{:03d}Z","level":"{}")",
-                 fmt::gmtime(std::chrono::system_clock::to_time_t(msg.time)), millis,
+  fmt::format_to(out, R"({{"time":"{}","level":"{}")", UtcText(msg.time),
                  std::string_view(level.data(), level.size()));
   if (payload.size() >= 2 && payload.front() == '{' && payload.back() == '}') {
     if (payload.size() > 2)

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <chrono>
+
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -36,6 +38,8 @@ struct CallRecord {
 std::string FormatCallText(const CallRecord& record);
 /// The same fields as one JSON object (`{"event":"call","rpc":…}`), strings escaped.
 std::string FormatCallJson(const CallRecord& record);
+/// "2026-12-02T17:45:14.586Z": a time in UTC to the millisecond (log lines, /debug/calls).
+std::string UtcText(std::chrono::system_clock::time_point time);
 /// `text` with JSON string escaping, without the quotes.
 std::string JsonEscape(const std::string& text);
 

@@ -23,7 +23,7 @@ struct ViewCloud {
 
 /// Every k-th point of a scan (k = ceil(size / max_points)), the same points for the same scan,
 /// moved into the bin frame (`unit` → metres, then X_BinSensor); non-finite points are skipped.
-/// Reads only the kept points: about 1 ms for 200 k points, whatever the scan's size.
+/// Reads only the kept points (a twelfth of a 2.3 M-point scan at 200 k), whatever the scan's size.
 /// @throws InvalidArgument when max_points is 0.
 ViewCloud ThinToBin(const PackedXyz& xyz_Sensor, LengthUnit unit, const Eigen::Isometry3d& X_BinSensor,
                     std::size_t max_points);

@@ -2,13 +2,12 @@
 
 #include <fmt/core.h>
 
-#include <fstream>
 #include <memory>
-#include <sstream>
 
 #include "clients/cli/inputs/cli_inputs.h"
 #include "clients/cli/local/plan_command.h"
 #include "core/common/errors.h"
+#include "core/common/yaml_reader.h"
 #include "viewer/view_page.h"
 #include "wire/proto_convert.h"
 #include "wire/response_convert.h"
@@ -25,14 +24,6 @@ struct ViewOptions {
   bool no_sim = false;
   std::size_t max_points = 200'000;
 };
-
-std::string ReadTextFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidArgument(fmt::format("cannot read {}", path));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // A plan or model drawn over another cloud would look right and be wrong: the response names the
 // points it was made from.
