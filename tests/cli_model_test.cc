@@ -83,6 +83,23 @@ TEST(CliModel, BadInputsGiveClearErrors) {
   fs::remove_all(dir);
 }
 
+TEST(CliModel, ViewRefusesAJsonThatIsNotAResponseOfItsCloud) {
+  const fs::path dir = TempDir("view");
+  { std::ofstream(dir / "bad.json") << "{\"plans\": 3}\n"; }
+  CliRun run =
+      RunCli("view --tubes 2 --plan " + (dir / "bad.json").string() + " --out " + (dir / "p.html").string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("bad.json is not a PlanPickResponse in proto3 JSON"));
+  // A model of one cloud over another: refused, naming both sizes.
+  ASSERT_EQ(RunCli("model --tubes 2 --seed 1 --json " + (dir / "m.json").string()).exit_code, 0);
+  run = RunCli("view --tubes 2 --seed 2 --model " + (dir / "m.json").string() + " --out " +
+               (dir / "p.html").string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("m.json was made from a cloud of"));
+  EXPECT_FALSE(fs::exists(dir / "p.html"));
+  fs::remove_all(dir);
+}
+
 TEST(CliModel, ACloudThatMissesTheBinIsExitCode4NeverBinEmpty) {
   const fs::path dir = TempDir("misfit");
   const auto cloud =
