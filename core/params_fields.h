@@ -132,6 +132,27 @@ void DescribeFields(Visit& v, JoiningParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, JunctionParams& p) {
+  v("max_gap", p.max_gap, "Y-pieces: each free end's axis is extended by its radius plus this, m");
+  v("max_axis_offset", p.max_axis_offset, "Y-pieces: between two extended axes where they meet, m");
+  v("side_max_gap", p.side_max_gap, "T-pieces: from a free end to the surface of the tube it meets, m");
+  v("side_max_axis_offset", p.side_max_axis_offset, "T-pieces: between the extended axis and the other, m");
+  v("min_angle", p.min_angle, "radians, between the branch and the axis it meets");
+  v("min_meeting_ends", p.min_meeting_ends, "free ends meeting at one point that make a node");
+  v("max_branches_per_node", p.max_branches_per_node);
+  v("node_spacing", p.node_spacing);
+  v("chain_max_distance", p.chain_max_distance, "linear joining before junctions: at most this, m");
+  v("chain_max_angle", p.chain_max_angle, "linear joining before junctions: at most this, radians");
+  v("link_max_distance", p.link_max_distance, "two free ends meeting alone: linked within this, m");
+  v("link_max_angle", p.link_max_angle, "two free ends meeting alone: linked within this α + β, radians");
+  v("max_tube_length", p.max_tube_length);
+  v("auto_min_junctions", p.auto_min_junctions,
+    "topology auto: junctions a scene needs to count as branched");
+  v("auto_min_per_tube", p.auto_min_per_tube, "topology auto: and this many per tube they leave");
+  v("auto_min_y_pieces", p.auto_min_y_pieces, "topology auto: or this many Y-pieces");
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, PlausibilityParams& p) {
   v("check", p.check, "false: no error for a cloud that misses the bin");
   v("margin_xy", p.margin_xy, "bin volume: inner x/y extent grown by this, m");
@@ -151,6 +172,7 @@ void DescribeFields(Visit& v, ModelingParams& p) {
   v.Section("segmentation", p.segmentation);
   v.Section("cylinders", p.cylinders);
   v.Section("joining", p.joining);
+  v.Section("junctions", p.junctions);
   v.Section("plausibility", p.plausibility);
 }
 
@@ -159,6 +181,7 @@ void DescribeFields(Visit& v, ModelingParams& p) {
 template <typename Visit>
 void DescribeFields(Visit& v, ClassificationParams& p) {
   v("length_tolerance", p.length_tolerance);
+  v("junction_gap", p.junction_gap);
 }
 
 template <typename Visit>

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/common/errors.h"
+#include "core/common/segment_geometry.h"
 
 namespace tubepick::physics {
 namespace {
@@ -154,38 +155,6 @@ TubeGeometry DrawTube(const RandomTubeParams& params, int id, std::mt19937_64& r
   return tube;
 }
 
-/// Closest distance between segments [p1, q1] and [p2, q2] (Ericson, Real-Time Collision
-/// Detection §5.1.9).
-double SegmentDistance(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1, const Eigen::Vector3d& p2,
-                       const Eigen::Vector3d& q2) {
-  const Eigen::Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  constexpr double kEps = 1e-18;
-  double s = 0.0, t = 0.0;
-  if (a <= kEps && e <= kEps) return r.norm();
-  if (a <= kEps) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= kEps) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2);
-      const double denom = a * e - b * b;
-      s = denom > kEps ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0.0) {
-        t = 0.0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-      } else if (t > 1.0) {
-        t = 1.0;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-      }
-    }
-  }
-  return ((p1 + s * d1) - (p2 + t * d2)).norm();
-}
-
 }  // namespace
 
 RandomTubeParams RandomTubeParams::SetA() { return RandomTubeParams{}; }
@@ -295,8 +264,9 @@ double SelfClearance(const TubeGeometry& tube) {
       const auto [c, d] = ends[f];
       const double gap = std::min({dist[a * n + c], dist[a * n + d], dist[b * n + c], dist[b * n + d]});
       if (gap <= two_r) continue;  // neighbours along the tube: they may legitimately come close
-      const double distance = SegmentDistance(tube.nodes[a].centre, tube.nodes[b].centre,
-                                              tube.nodes[c].centre, tube.nodes[d].centre);
+      const double distance = ClosestPointsOfSegments(tube.nodes[a].centre, tube.nodes[b].centre,
+                                                      tube.nodes[c].centre, tube.nodes[d].centre)
+                                  .distance;
       clearance = std::min(clearance, distance - two_r);
     }
   }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/common/errors.h"
+#include "core/common/tube_graph.h"
 #include "physics/bin_solids.h"
 #include "physics/tube_geometry.h"
 
@@ -84,19 +85,27 @@ std::vector<TubeSegment> MakeTubeSegments(const Tube& tube, double joint_min_len
     }
     if (!(c.length() > 0.0)) throw InvalidArgument(where + ": length = 0, expected > 0");
   }
+  ValidateTubeGraph(tube, name);
+  // A sphere closes every cylinder end where the tube goes on: a joint, or a junction node.
   const std::size_t n = tube.cylinders.size();
+  std::vector<bool> sphere_start(n, false), sphere_end(n, false);
+  const std::vector<TubeJoint> joints = TubeJoints(tube);
+  for (const TubeJoint& j : joints) {
+    if (j.cylinder_a >= 0) sphere_end[static_cast<std::size_t>(j.cylinder_a)] = true;
+    if (j.cylinder_b >= 0) sphere_start[static_cast<std::size_t>(j.cylinder_b)] = true;
+  }
+  const std::vector<std::uint32_t> degree = NodeDegrees(tube);
+  for (const TubeBranch& b : BranchesOf(tube)) {
+    if (degree[b.from_node] > 1) sphere_start[b.first_cylinder] = true;
+    if (degree[b.to_node] > 1) sphere_end[b.first_cylinder + b.cylinder_count - 1] = true;
+  }
   std::vector<TubeSegment> segments;
   for (std::size_t i = 0; i < n; ++i) {
     const Cylinder& c = tube.cylinders[i];
-    segments.push_back(
-        {c.start, c.end, c.radius, /*sphere_a=*/i > 0, /*sphere_b=*/i + 1 < n, /*joint=*/false});
+    segments.push_back({c.start, c.end, c.radius, sphere_start[i], sphere_end[i], /*joint=*/false});
   }
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    const Cylinder& c0 = tube.cylinders[i];
-    const Cylinder& c1 = tube.cylinders[i + 1];
-    if ((c1.start - c0.end).norm() > joint_min_length) {
-      segments.push_back({c0.end, c1.start, 0.5 * (c0.radius + c1.radius), true, true, /*joint=*/true});
-    }
+  for (const TubeJoint& j : joints) {
+    if (j.length() > joint_min_length) segments.push_back({j.a, j.b, j.radius, true, true, /*joint=*/true});
   }
   return segments;
 }

@@ -25,6 +25,7 @@ ModelingResult Model(const PlanningJob& job, const RawRegion& raw_region_Bin, st
   input.unit = job.unit;
   input.X_BinSensor = job.cell.sensor.X_BinSensor;
   input.bin = job.cell.bin;
+  input.topology = job.cell.tube.topology;
   input.seed = job.seed;
   ModelingParams params = job.params.modeling;
   params.threads = threads;

@@ -9,6 +9,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/require.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick {
 namespace {
@@ -69,6 +70,14 @@ v1::Tube ToProto(const Tube& tube) {
   out.set_length(tube.length());
   out.set_occlusion(ToProto(tube.occlusion));
   out.set_occluded_joint_count(tube.occluded_joint_count);
+  for (const TubeNode& n : NodesOf(tube)) *out.add_nodes()->mutable_position() = ToProto(n.p_Bin);
+  for (const TubeBranch& b : BranchesOf(tube)) {
+    v1::TubeBranch* pb = out.add_branches();
+    pb->set_from_node(b.from_node);
+    pb->set_to_node(b.to_node);
+    pb->set_first_cylinder(b.first_cylinder);
+    pb->set_cylinder_count(b.cylinder_count);
+  }
   return out;
 }
 

@@ -19,6 +19,25 @@ LengthUnit ParseLengthUnit(const std::string& text, const std::string& field) {
 
 std::string ToString(LengthUnit unit) { return unit == LengthUnit::kMillimetre ? "mm" : "m"; }
 
+std::string ToString(TubeTopology topology) {
+  switch (topology) {
+    case TubeTopology::kLinear:
+      return "linear";
+    case TubeTopology::kBranched:
+      return "branched";
+    case TubeTopology::kAuto:
+      return "auto";
+  }
+  return "?";
+}
+
+TubeTopology ParseTubeTopology(const std::string& text, const std::string& field) {
+  if (text == "linear") return TubeTopology::kLinear;
+  if (text == "branched") return TubeTopology::kBranched;
+  if (text == "auto") return TubeTopology::kAuto;
+  throw InvalidArgument(field + ": unknown topology '" + text + "' (expected linear, branched or auto)");
+}
+
 Eigen::Isometry3d SensorConfig::DefaultX_BinSensor() {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   // Optical frame looking down: rotation of π about x (x right, y down, z forward = −z_bin).

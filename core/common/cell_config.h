@@ -31,6 +31,22 @@ struct SensorConfig {
   static Eigen::Isometry3d DefaultX_BinSensor();
 };
 
+/// What shape of tube a cell holds.
+enum class TubeTopology {
+  /// Paths only: modeling looks for no junctions.
+  kLinear,
+  /// Trees (hose assemblies with T- and Y-pieces): chains are joined at junctions.
+  kBranched,
+  /// Decided per scene: junctions are kept when the scene shows enough of them
+  /// (modeling.junctions.auto_min_junctions and auto_min_share).
+  kAuto,
+};
+
+/// "linear", "branched", "auto".
+std::string ToString(TubeTopology topology);
+/// @throws InvalidArgument naming `field`, the value and the accepted ones.
+TubeTopology ParseTubeTopology(const std::string& text, const std::string& field);
+
 struct TubeConfig {
   /// Tube radius, metres.
   double radius = 0.0125;
@@ -38,6 +54,8 @@ struct TubeConfig {
   double length = 0.50;
   /// Mass of one tube, kg.
   double mass = 0.055;
+  /// Linear tubes, branched ones, or decided per scene.
+  TubeTopology topology = TubeTopology::kLinear;
 };
 
 /// Where placed tubes go: X_BinPlace is the destination frame the tube's PCA frame is aligned

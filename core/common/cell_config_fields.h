@@ -27,6 +27,9 @@ void DescribeFields(Visit& v, TubeConfig& tube) {
   v("radius", tube.radius, "Tube radius, m.");
   v("length", tube.length, "Curve length, m; 0 = unknown.");
   v("mass", tube.mass, "Mass of one tube, kg.");
+  v.Enum(
+      "topology", tube.topology, [](TubeTopology t) { return ToString(t); }, ParseTubeTopology,
+      "linear, branched (hose assemblies: junctions are looked for) or auto (decided per scene).");
 }
 
 template <typename Visit>

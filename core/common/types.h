@@ -40,23 +40,44 @@ struct Cylinder {
 
 enum class Occlusion { kUnspecified = 0, kNone = 1, kWeak = 2, kStrong = 3 };
 
-/// A virtual tube (thesis Def. 4.2.2): an ordered list of cylinders; consecutive cylinders are
-/// linked by a joint from cylinders[i].end to cylinders[i+1].start.
+/// A node of a tube's graph: a free end of the tube or a junction where three or more branches
+/// meet. Bin frame.
+struct TubeNode {
+  Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
+};
+
+/// One branch of a tube: the chain of cylinders [first_cylinder, first_cylinder + cylinder_count)
+/// of Tube::cylinders, ordered and oriented from node `from_node` to node `to_node`. Consecutive
+/// cylinders of a branch are linked by a joint; the branch's first cylinder starts at its
+/// from_node's position or is linked to it by a joint (a junction), and likewise at its end.
+struct TubeBranch {
+  std::uint32_t from_node = 0;
+  std::uint32_t to_node = 0;
+  std::uint32_t first_cylinder = 0;
+  std::uint32_t cylinder_count = 0;
+
+  bool operator==(const TubeBranch&) const = default;
+};
+
+/// A virtual tube (thesis Def. 4.2.2), generalised to a tree: branches of cylinders between
+/// nodes (ends and junctions). A linear tube is the one-branch case and may leave `nodes` and
+/// `branches` empty: its cylinders are then one branch, consecutive cylinders linked by a joint
+/// from cylinders[i].end to cylinders[i+1].start (core/common/tube_graph.h reads both forms).
 struct Tube {
   std::uint32_t id = 0;
+  /// All cylinders, branch by branch.
   std::vector<Cylinder> cylinders;
+  /// Empty for a linear tube given by its cylinders alone.
+  std::vector<TubeNode> nodes;
+  /// Empty for a linear tube given by its cylinders alone; otherwise they cover `cylinders`.
+  std::vector<TubeBranch> branches;
   Occlusion occlusion = Occlusion::kUnspecified;
   std::uint32_t occluded_joint_count = 0;
 
-  /// Cylinder lengths plus joint lengths (Def. 4.2.6).
-  double length() const {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < cylinders.size(); ++i) {
-      sum += cylinders[i].length();
-      if (i + 1 < cylinders.size()) sum += (cylinders[i + 1].start - cylinders[i].end).norm();
-    }
-    return sum;
-  }
+  /// Has a junction: a node where three or more branches meet.
+  bool branched() const;
+  /// Cylinder lengths plus joint lengths (Def. 4.2.6), over all branches.
+  double length() const;
 };
 
 }  // namespace tubepick

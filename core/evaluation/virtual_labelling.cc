@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "core/common/errors.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick {
 namespace {
@@ -53,16 +54,11 @@ VirtualLabels LabelVirtualTubes(const Points& points_Bin, const std::vector<std:
 
   std::vector<Capsule> capsules;
   for (std::size_t t = 0; t < tubes.size(); ++t) {
-    const auto& cyl = tubes[t].cylinders;
-    for (std::size_t c = 0; c < cyl.size(); ++c) {
-      if (params.label_inside_cylinders) {
-        capsules.push_back(MakeCapsule(cyl[c].start, cyl[c].end, cyl[c].radius, static_cast<std::int32_t>(t),
-                                       2, params.tolerance));
-      }
-      if (c + 1 < cyl.size()) {
-        capsules.push_back(MakeCapsule(cyl[c].end, cyl[c + 1].start,
-                                       0.5 * (cyl[c].radius + cyl[c + 1].radius),
-                                       static_cast<std::int32_t>(t), 1, params.tolerance));
+    for (const AxisPiece& piece : TubeAxisPieces(tubes[t])) {
+      const bool joint = piece.cylinder < 0;
+      if (joint || params.label_inside_cylinders) {
+        capsules.push_back(MakeCapsule(piece.a, piece.b, piece.radius, static_cast<std::int32_t>(t),
+                                       joint ? 1 : 2, params.tolerance));
       }
     }
   }

@@ -26,6 +26,29 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Which tube took each of the n filtered points: the tube holding each fitted cylinder, whole
+// (joining may reverse it: same segment, same axis) or cut at a junction (its pieces lie on its
+// axis).
+std::vector<std::int32_t> TubeOfPoint(const std::vector<Tube>& tubes, const std::vector<Cylinder>& fitted,
+                                      const std::vector<const std::vector<std::uint32_t>*>& inliers_of,
+                                      std::size_t n) {
+  std::vector<std::int32_t> tube_of_point(n, -1);
+  for (std::size_t k = 0; k < fitted.size(); ++k) {
+    const Cylinder& f = fitted[k];
+    const Eigen::Vector3d axis = f.axis();
+    auto on_axis = [&](const Cylinder& c) {
+      const Eigen::Vector3d d = c.centre() - f.start;
+      return c.segment_id == f.segment_id && c.radius == f.radius && (d - d.dot(axis) * axis).norm() < 1e-9;
+    };
+    for (const Tube& tube : tubes) {
+      if (std::none_of(tube.cylinders.begin(), tube.cylinders.end(), on_axis)) continue;
+      for (const std::uint32_t i : *inliers_of[k]) tube_of_point[i] = static_cast<std::int32_t>(tube.id);
+      break;
+    }
+  }
+  return tube_of_point;
+}
+
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // SplitMix64: derives independent, reproducible seeds for each stochastic step.
@@ -198,26 +221,31 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   if (params.joining.visibility_check && !cloud.points.empty()) {
     visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
   }
-  result.tubes = JoinTubes(cylinders, params.joining, visibility ? &*visibility : nullptr, stop);
-  result.timings.push_back({"joining", SecondsSince(t0)});
-
-  // Which tube took each filtered point: match output cylinders to fitted ones by their centre
-  // (joining may reverse a cylinder, which leaves its centre bit-identical).
-  result.tube_of_point.assign(cloud.size(), -1);
-  std::map<std::tuple<double, double, double, std::uint32_t>, std::size_t> fitted_by_centre;
-  for (std::size_t k = 0; k < cylinders.size(); ++k) {
-    const Eigen::Vector3d c = cylinders[k].centre();
-    fitted_by_centre.emplace(std::make_tuple(c.x(), c.y(), c.z(), cylinders[k].segment_id), k);
-  }
-  for (const Tube& tube : result.tubes) {
-    for (const Cylinder& cyl : tube.cylinders) {
-      const Eigen::Vector3d c = cyl.centre();
-      const auto it = fitted_by_centre.find(std::make_tuple(c.x(), c.y(), c.z(), cyl.segment_id));
-      if (it == fitted_by_centre.end()) continue;
-      for (std::uint32_t i : *inliers_of[it->second])
-        result.tube_of_point[i] = static_cast<std::int32_t>(tube.id);
+  const RangeImage* seen = visibility ? &*visibility : nullptr;
+  if (input.topology == TubeTopology::kLinear) {
+    result.tubes = JoinTubes(cylinders, params.joining, seen, stop);
+  } else {
+    // 6. Junctions. Chains are joined within stricter limits first (JunctionParams::
+    // chain_max_distance), then into trees; `auto` keeps the plain linear joining when the scene
+    // does not look branched.
+    JoiningParams chain_joining = params.joining;
+    chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
+    chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
+    const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
+    JunctionJoining joined = JoinJunctions(chains, params.junctions, stop);
+    const bool branched =
+        input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
+    spdlog::debug("junctions: {} ({} Y-pieces) joining {} of {} chains into {} tubes; topology {}: {}",
+                  joined.junctions, joined.y_pieces, joined.chains_in_junctions, chains.size(),
+                  joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
+    if (branched) {
+      result.tubes = std::move(joined.tubes);
+    } else {
+      result.tubes = JoinTubes(cylinders, params.joining, seen, stop);
     }
   }
+  result.tube_of_point = TubeOfPoint(result.tubes, cylinders, inliers_of, cloud.size());
+  result.timings.push_back({"joining", SecondsSince(t0)});
 
   result.total_seconds = SecondsSince(t_start);
   spdlog::debug("modeled {} tubes from {} points ({} filtered, {} segments, {} cylinders) in {:.3f} s",

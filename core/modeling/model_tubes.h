@@ -9,6 +9,7 @@
 #include "core/common/types.h"
 #include "core/modeling/cloud_plausibility.h"
 #include "core/modeling/cloud_prepare.h"
+#include "core/modeling/junction_joining.h"
 #include "core/modeling/modeling_params.h"
 
 namespace tubepick {
@@ -27,6 +28,9 @@ struct ModelingInput {
   /// those a finger box can reach (RawRegionForPlanning); modeling alone needs none
   /// (RawRegion::None()), and every point kept is memory the call touches.
   RawRegion raw_region_Bin;
+  /// The shape of the cell's tubes (CellConfig tube.topology): whether joining looks for
+  /// junctions.
+  TubeTopology topology = TubeTopology::kLinear;
 };
 
 struct StageTiming {

@@ -54,6 +54,7 @@ void ModelingParams::Validate() const {
     throw InvalidArgument("modeling.joining.visibility_window: " + std::to_string(j.visibility_window) +
                           " is out of range [0, 1000]");
   }
+  junctions.Validate();
   plausibility.Validate();
   if (threads > 1024)
     throw InvalidArgument("modeling.threads: " + std::to_string(threads) + " is out of range [0, 1024]");

@@ -6,6 +6,7 @@
 #include "core/modeling/cloud_plausibility.h"
 #include "core/modeling/cylinder_fit.h"
 #include "core/modeling/filters.h"
+#include "core/modeling/junction_joining.h"
 #include "core/modeling/normals.h"
 #include "core/modeling/segmentation.h"
 #include "core/modeling/tube_joining.h"
@@ -22,6 +23,8 @@ struct ModelingParams {
   SegmentationParams segmentation;
   CylinderFitParams cylinders;
   JoiningParams joining;
+  /// Junctions (branched tubes), when the cell's topology asks for them.
+  JunctionParams junctions;
   /// The check, right after the cloud enters the bin frame, that it looks like the cell.
   PlausibilityParams plausibility;
   /// Worker threads for normals and per-segment fitting; 0 = all cores. Results do not depend

@@ -12,6 +12,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/require.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick {
 namespace {
@@ -62,22 +63,22 @@ Distribution FromPoints(const Points& points_Bin) {
   return d;
 }
 
-// The axis polyline: cylinder axes and the joints between consecutive cylinders, uniformly dense.
+// The axis polyline (TubeAxisPieces: cylinders, joints, junction links), uniformly dense.
 Distribution FromTube(const Tube& tube_Bin) {
   if (tube_Bin.cylinders.empty()) {
     throw InvalidArgument("tube " + std::to_string(tube_Bin.id) +
                           ": the tube frame needs at least one cylinder");
   }
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments;
   for (std::size_t i = 0; i < tube_Bin.cylinders.size(); ++i) {
     const Cylinder& c = tube_Bin.cylinders[i];
     if (!c.start.allFinite() || !c.end.allFinite()) {
       throw InvalidArgument("tube " + std::to_string(tube_Bin.id) + ": cylinders[" + std::to_string(i) +
                             "] has a non-finite endpoint");
     }
-    if (i > 0) segments.emplace_back(tube_Bin.cylinders[i - 1].end, c.start);
-    segments.emplace_back(c.start, c.end);
   }
+  ValidateTubeGraph(tube_Bin, "tube " + std::to_string(tube_Bin.id));
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> segments;
+  for (const AxisPiece& piece : TubeAxisPieces(tube_Bin)) segments.emplace_back(piece.a, piece.b);
   Distribution d;
   double total = 0.0;
   for (const auto& [a, b] : segments) {

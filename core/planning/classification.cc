@@ -6,17 +6,22 @@
 
 #include "core/common/errors.h"
 #include "core/common/require.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick {
 
-std::vector<std::uint32_t> OccludedJoints(const Tube& tube) {
-  std::vector<std::uint32_t> joints;
-  for (std::size_t i = 0; i + 1 < tube.cylinders.size(); ++i) {
-    if (tube.cylinders[i].segment_id != tube.cylinders[i + 1].segment_id) {
-      joints.push_back(static_cast<std::uint32_t>(i));
-    }
+std::vector<std::uint32_t> OccludedJoints(const Tube& tube, const ClassificationParams& params) {
+  std::vector<std::uint32_t> occluded;
+  const std::vector<TubeJoint> joints = TubeJoints(tube);
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const TubeJoint& j = joints[i];
+    const bool hidden = j.junction_link()
+                            ? j.length() > j.radius + params.junction_gap
+                            : tube.cylinders[static_cast<std::size_t>(j.cylinder_a)].segment_id !=
+                                  tube.cylinders[static_cast<std::size_t>(j.cylinder_b)].segment_id;
+    if (hidden) occluded.push_back(static_cast<std::uint32_t>(i));
   }
-  return joints;
+  return occluded;
 }
 
 Occlusion OcclusionOf(std::size_t occluded_joint_count) {
@@ -40,6 +45,7 @@ double MinimumTubeLength(double expected_length, const ClassificationParams& par
 ClassificationResult ClassifyTubes(const std::vector<Tube>& tubes, double expected_length,
                                    const ClassificationParams& params) {
   RequireNonNegative(params.length_tolerance, "planning.classification.length_tolerance");
+  RequireNonNegative(params.junction_gap, "planning.classification.junction_gap");
   RequireNonNegative(expected_length, "tube.length");
   const double minimum = MinimumTubeLength(expected_length, params);
 
@@ -50,14 +56,9 @@ ClassificationResult ClassifyTubes(const std::vector<Tube>& tubes, double expect
     const Tube& tube = tubes[t];
     const std::string name = "tubes[" + std::to_string(t) + "]";
     if (tube.cylinders.empty()) throw InvalidArgument(name + ": has no cylinders");
-    for (std::size_t c = 0; c < tube.cylinders.size(); ++c) {
-      const Cylinder& cyl = tube.cylinders[c];
-      if (!cyl.start.allFinite() || !cyl.end.allFinite() || !std::isfinite(cyl.radius)) {
-        throw InvalidArgument(name + ".cylinders[" + std::to_string(c) + "]: non-finite endpoint or radius");
-      }
-    }
+    ValidateTubeGraph(tube, name);
     TubeClass& cls = result.classes[t];
-    cls.occluded_joints = OccludedJoints(tube);
+    cls.occluded_joints = OccludedJoints(tube, params);
     cls.occlusion = OcclusionOf(cls.occluded_joints.size());
     cls.too_short = minimum > 0.0 && tube.length() < minimum;
     result.tubes[t].occlusion = cls.occlusion;

@@ -13,6 +13,10 @@ struct ClassificationParams {
   /// Subtracted from the expected tube length (TubeConfig::length) to get the minimum length of
   /// a complete virtual tube, metres (Table 5.3, set A: 50 cm tubes, 35 cm minimum).
   double length_tolerance = 0.15;
+  /// A link between a junction node and a branch of a branched tube is an occluded joint when
+  /// it is longer than the branch's radius plus this, metres: at a junction seen whole, the
+  /// branch's first cylinder starts about one radius from the node (on the other branch's axis).
+  double junction_gap = 0.02;
 };
 
 /// Cylinder indices [begin, end) of a tube: a section, or the cylinders a grasp may use.
@@ -28,7 +32,8 @@ struct CylinderRange {
 /// What classification found for one tube.
 struct TubeClass {
   Occlusion occlusion = Occlusion::kUnspecified;
-  /// Occluded joints (Def. 5.2.1), ascending; joint i links cylinders[i].end to cylinders[i+1].start.
+  /// Occluded joints (Def. 5.2.1), ascending indices into TubeJoints(tube); on a linear tube
+  /// joint i links cylinders[i].end to cylinders[i+1].start.
   std::vector<std::uint32_t> occluded_joints;
   /// Shorter than the minimum length: an incomplete model, never a pick candidate (it still
   /// takes part in simulations as an obstacle).
@@ -36,8 +41,9 @@ struct TubeClass {
 };
 
 /// Occluded joints of `tube` (Def. 5.2.1): joints whose two cylinders come from different
-/// segments. Ascending joint indices.
-std::vector<std::uint32_t> OccludedJoints(const Tube& tube);
+/// segments, and links to a junction node longer than the branch's radius plus
+/// params.junction_gap. Ascending indices into TubeJoints(tube).
+std::vector<std::uint32_t> OccludedJoints(const Tube& tube, const ClassificationParams& params = {});
 
 /// NONE for 0 occluded joints (Def. 5.2.2), WEAK for 1 (Def. 5.2.3), STRONG for 2+ (Def. 5.2.4).
 Occlusion OcclusionOf(std::size_t occluded_joint_count);

@@ -63,12 +63,24 @@ double HeightCost(double grasp_z, double max_z);
 /// curve distance is used: it is the lever arm along the tube.)
 double CentreCost(double curve_position, double tube_length);
 
+/// C_cost on a branched tube, which has no one middle along a curve: the distance from the grasp
+/// point to the tube's mass centre (TubeMassCentre) over the largest distance of a cylinder
+/// endpoint from it, clamped to [0, 1]: the lever arm of the whole tube's weight about the grasp.
+double MassCentreCost(const Eigen::Vector3d& p_Bin_grasp, const Tube& tube);
+
+/// C_cost of a grasp on `tube`: CentreCost along the curve on a one-branch (linear) tube,
+/// MassCentreCost on a tube of several branches.
+double GraspCentreCost(const Grasp& grasp, const Tube& tube);
+
 /// T_cost = min(disp, disp_max)/disp_max (Eq. 5.6); 0 when not simulated (nullopt).
 double TrajectoryCost(std::optional<double> displacement, double max_displacement);
 
 /// All three terms and G_cost (Eq. 5.3).
 PlanCosts PlanCost(double grasp_z, double max_z, double curve_position, double tube_length,
                    std::optional<double> displacement, const CostParams& params);
+/// The same for a grasp on `tube` (C_cost from GraspCentreCost).
+PlanCosts PlanCost(const Grasp& grasp, const Tube& tube, double max_z, std::optional<double> displacement,
+                   const CostParams& params);
 
 /// Strict weak order, best first: lower total cost, then lower tube id, then lower trajectory
 /// index, then lower curve position, then lower cylinder index.

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/common/tube_graph.h"
+
 namespace tubepick {
 
 std::optional<Eigen::Isometry3d> GraspFrame(const Eigen::Vector3d& p_Bin_grasp,
@@ -23,9 +25,14 @@ std::optional<Eigen::Isometry3d> GraspFrame(const Eigen::Vector3d& p_Bin_grasp,
 
 std::vector<double> CylinderCurveOffsets(const Tube& tube) {
   std::vector<double> offsets(tube.cylinders.size(), 0.0);
-  for (std::size_t i = 1; i < tube.cylinders.size(); ++i) {
-    offsets[i] = offsets[i - 1] + tube.cylinders[i - 1].length() +
-                 (tube.cylinders[i].start - tube.cylinders[i - 1].end).norm();
+  const std::vector<TubeNode> nodes = NodesOf(tube);
+  for (const TubeBranch& b : BranchesOf(tube)) {
+    double s = (tube.cylinders[b.first_cylinder].start - nodes[b.from_node].p_Bin).norm();
+    for (std::uint32_t i = b.first_cylinder; i < b.first_cylinder + b.cylinder_count; ++i) {
+      if (i > b.first_cylinder) s += (tube.cylinders[i].start - tube.cylinders[i - 1].end).norm();
+      offsets[i] = s;
+      s += tube.cylinders[i].length();
+    }
   }
   return offsets;
 }

@@ -40,8 +40,9 @@ struct Grasp {
   Eigen::Vector3d p_Bin_grasp = Eigen::Vector3d::Zero();
   /// Which cylinder of the tube holds the grasp point.
   std::uint32_t cylinder_index = 0;
-  /// Distance of the grasp point along the tube's curve (cylinders and joints, as Tube::length())
-  /// from cylinders.front().start, metres.
+  /// Distance of the grasp point along its branch's curve (cylinders and joints, as
+  /// Tube::length()) from the branch's from_node; on a linear tube from cylinders.front().start,
+  /// metres.
   double curve_position = 0.0;
 };
 
@@ -50,7 +51,8 @@ struct Grasp {
 std::optional<Eigen::Isometry3d> GraspFrame(const Eigen::Vector3d& p_Bin_grasp,
                                             const Eigen::Vector3d& axis_Bin);
 
-/// Curve positions of each cylinder's start along the tube (cylinder lengths plus joint lengths).
+/// Curve positions of each cylinder's start along its branch from the branch's from_node
+/// (cylinder lengths plus joint lengths; a linear tube's one branch starts at its first cylinder).
 std::vector<double> CylinderCurveOffsets(const Tube& tube);
 
 /// Grasp points along each cylinder's axis: on a cylinder of length ℓ, the usable stretch is

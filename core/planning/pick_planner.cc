@@ -69,6 +69,7 @@ class StageTimer {
 
 void PlanningParams::Validate() const {
   RequireNonNegative(classification.length_tolerance, "planning.classification.length_tolerance");
+  RequireNonNegative(classification.junction_gap, "planning.classification.junction_gap");
 
   const TrajectoryParams& t = trajectories;
   RequirePositive(t.upward_distance, "planning.trajectories.upward_distance");
@@ -306,8 +307,7 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
       plan.escape_direction = trajectory.escape_direction;
       plan.trajectory_index = c.trajectory;
       plan.displacement = displacement[c.trajectory];
-      plan.costs = PlanCost(grasp.p_Bin_grasp.z(), max_z, grasp.curve_position, tube.length(),
-                            plan.displacement, params.cost);
+      plan.costs = PlanCost(grasp, tube, max_z, plan.displacement, params.cost);
       result.plans.push_back(std::move(plan));
     }
     RankPlans(&result.plans);

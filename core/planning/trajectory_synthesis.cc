@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/common/tube_graph.h"
+
 namespace tubepick {
 namespace {
 
@@ -137,6 +139,9 @@ std::vector<Trajectory> SynthesizeTrajectories(std::uint32_t tube_index, const T
   out.push_back(UpwardTrajectory(tube_index, tube, params));
   const double d_const = params.escape_constant > 0.0 ? params.escape_constant : 3.0 * tube_radius;
   const auto n = static_cast<std::uint32_t>(tube.cylinders.size());
+  // Escapes move one section of a linear tube out from under its occluder; a branched tube's
+  // sections are subtrees, not cylinder ranges, so it is lifted straight up (and simulated).
+  if (BranchesOf(tube).size() > 1) return out;
 
   if (cls.occlusion == Occlusion::kWeak) {
     assert(cls.occluded_joints.size() == 1);

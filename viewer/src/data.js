@@ -69,16 +69,67 @@ export function framePlans(frame) {
   return Array.isArray(frame?.plan?.plans) ? frame.plan.plans : [];
 }
 
-function normTube(t) {
+/** The linear reading of a tube without a graph: one branch over all cylinders, first start to last end. */
+function linearGraph(cylinders) {
+  if (!cylinders.length) return { nodes: [], branches: [] };
+  const nodes = [cylinders[0].start.clone(), cylinders[cylinders.length - 1].end.clone()];
+  return { nodes, branches: [{ from: 0, to: 1, first: 0, count: cylinders.length }] };
+}
+
+/** Why a branch does not fit its tube (node or cylinder index out of range), or null. */
+function branchProblem(b, nodeCount, cylinderCount) {
+  if (b.from >= nodeCount || b.to >= nodeCount) return `node ${Math.max(b.from, b.to)} of ${nodeCount}`;
+  if (b.count < 1 || b.first + b.count > cylinderCount) return `cylinders [${b.first}, ${b.first + b.count}) of ${cylinderCount}`;
+  return null;
+}
+
+/**
+ * The tube's graph: nodes (Vector3) and branches {from, to, first, count} (proto3 JSON omits zeros);
+ * without branches the linear reading. Branches that do not fit are dropped with a problem each.
+ */
+function tubeGraph(t, id, cylinders, problems) {
+  if (!nonEmpty(t.branches)) return linearGraph(cylinders);
+  const nodes = (t.nodes || []).map((n) => vec3(n?.position));
+  const branches = [];
+  t.branches.forEach((b, i) => {
+    const br = { from: num(b?.fromNode), to: num(b?.toNode), first: num(b?.firstCylinder), count: num(b?.cylinderCount) };
+    const bad = branchProblem(br, nodes.length, cylinders.length);
+    if (bad) problems.push(`tube ${id}: branch ${i} ignored: ${bad}`); else branches.push(br);
+  });
+  return { nodes, branches };
+}
+
+/** Branches per node (a node's degree). */
+function nodeDegrees(nodeCount, branches) {
+  const deg = new Array(nodeCount).fill(0);
+  for (const b of branches) { deg[b.from]++; deg[b.to]++; }
+  return deg;
+}
+
+function normTube(t, problems) {
   const cylinders = (t.cylinders || []).map((c) => ({
     start: vec3(c.start), end: vec3(c.end), radius: num(c.radius),
     segmentId: num(c.segmentId), inlierCount: num(c.inlierCount),
   }));
   const sum = cylinders.reduce((s, c) => s + c.start.distanceTo(c.end), 0);
+  const id = num(t.id);
+  const { nodes, branches } = tubeGraph(t, id, cylinders, problems);
+  const degrees = nodeDegrees(nodes.length, branches);
   return {
-    id: num(t.id), cylinders, length: t.length != null ? num(t.length) : sum,
+    id, cylinders, length: t.length != null ? num(t.length) : sum,
     occlusion: occlusionClass(t.occlusion), occludedJointCount: num(t.occludedJointCount),
+    nodes, branches, degrees, junctions: degrees.filter((d) => d >= 3).length,
   };
+}
+
+const plural = (k, one, many) => `${k} ${k === 1 ? one : many}`;
+
+/** Branches and junctions in words: "linear" (one branch, no junction), "5 branches, 2 junctions", short "5 br, 2 jn". */
+export function graphText(tube, short = false) {
+  const b = tube.branches.length, j = tube.junctions;
+  if (!b) return '–';
+  if (b === 1 && !j) return 'linear';
+  return short ? `${b} br, ${j} jn` : `${plural(b, 'branch', 'branches')}, ${plural(j, 'junction', 'junctions')}`;
 }
 
 export function occlusionClass(s) {
@@ -116,7 +167,7 @@ export function frameModel(frame) {
     error: frame.error ? String(frame.error) : '',
     chosenPlan: frame.chosen_plan == null ? null : num(frame.chosen_plan),
     cloud: xyz ? { xyz, points: num(frame.cloud.points) || xyz.length / 3, total: num(frame.cloud.total_points) } : null,
-    tubes: frameTubes(frame).map(normTube), plans: framePlans(frame).map(normPlan),
+    tubes: frameTubes(frame).map((t) => normTube(t, problems)), plans: framePlans(frame).map(normPlan),
     hasPlan: !!plan, plan, modeling, problems,
   };
 }

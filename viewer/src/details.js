@@ -2,6 +2,7 @@
 import { Vector3 } from 'three';
 import { el, fmt } from './dom.js';
 import { tubeColour } from './tubes.js';
+import { graphText } from './data.js';
 
 const MAX_WAYPOINTS = 4;
 
@@ -29,11 +30,19 @@ function costs(c) {
     el('i', {}, k), el('b', { 'data-field': `cost-${k}` }, fmt(c[k])))));
 }
 
+/** The plan's tube's branches and junctions when it is not linear (title: in words), else nothing. */
+function tubeShape(m, plan) {
+  const tube = m.tubes.find((t) => t.id === plan.tubeId);
+  const text = tube ? graphText(tube, true) : 'linear';
+  return text === 'linear' ? null : el('span', { class: 'pd-graph', 'data-field': 'tube-graph', title: graphText(tube) }, text);
+}
+
 function header(m, plan) {
   return el('div', { class: 'pd-head' },
     el('span', { class: 'pd-rank', 'data-field': 'rank' }, `#${plan.index + 1}`),
     el('span', { class: 'meta' }, `of ${m.plans.length}`),
     el('span', { class: 'pd-tube' }, el('span', { class: 'swatch', style: `background:${tubeColour(plan.tubeId)}` }), `tube ${plan.tubeId}`),
+    tubeShape(m, plan),
     el('span', { class: 'badge kind' }, plan.kind),
     m.chosenPlan === plan.index ? el('span', { class: 'badge exec', 'data-field': 'executed' }, 'executed') : null);
 }

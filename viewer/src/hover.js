@@ -3,6 +3,7 @@
 import { BufferGeometry, Float32BufferAttribute, Points, PointsMaterial } from 'three';
 import { el, fmt } from './dom.js';
 import { pickTube, pickCloudPoint } from './picking.js';
+import { graphText } from './data.js';
 
 const INTERVAL = 50; // ms between raycasts: 200 k points stay smooth
 
@@ -20,7 +21,7 @@ function hoverMarker() {
 function tubeText(m, id) {
   const t = m.tubes.find((x) => x.id === id);
   const best = m.plans.find((p) => p.tubeId === id);
-  return `tube ${id} · ${t.occlusion} occlusion · ${t.length.toFixed(3)} m · ${best ? `best plan #${best.index + 1} (G ${best.cost.G.toFixed(3)})` : 'no plan'}`;
+  return `tube ${id} · ${graphText(t)} · ${t.occlusion} occlusion · ${t.length.toFixed(3)} m · ${best ? `best plan #${best.index + 1} (G ${best.cost.G.toFixed(3)})` : 'no plan'}`;
 }
 
 function pointContent(cloud, hit) {

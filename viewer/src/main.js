@@ -7,7 +7,7 @@ import { applyPreset, presetBar, presetByKey } from './views.js';
 import { buildBin, buildPlacement } from './cell.js';
 import { gripperDims } from './gripper.js';
 import { colourCloud, HEIGHT_STOPS, labelledCount } from './cloud.js';
-import { styleTubes } from './tubes.js';
+import { styleTubes, partCounts } from './tubes.js';
 import { buildFrameObjects, showPlan, clearPlan, dispose } from './frame.js';
 import { pickTube, screenPointOfTube } from './picking.js';
 import { createHover } from './hover.js';
@@ -201,6 +201,14 @@ function installKeys() {
   });
 }
 
+/** A tube's graph as the viewer read it, and what it drew of it: {nodes, branches, junctions, drawn: {joint, link, junction, end}}. */
+function tubeGraph(id) {
+  const t = state.model?.tubes.find((x) => x.id === id);
+  const g = state.objs?.tubes.children.find((x) => x.userData.tubeId === id);
+  if (!t || !g) return null;
+  return { nodes: t.nodes.length, branches: t.branches.length, junctions: t.junctions, drawn: partCounts(g) };
+}
+
 function buildPanel() {
   const d = state.data;
   ui.frameSection = el('div');
@@ -266,6 +274,7 @@ window.tubepickViewer = {
   screenPoint: (p) => screenPoint(ui.view, vec3(p)),
   tubeCount: () => state.model?.tubes.length || 0,
   planCount: () => state.model?.plans.length || 0,
+  tubeGraph: (id) => tubeGraph(num(id)),
   screenPointOfTube: (id) => screenPointOfTube(ui.view, state.objs?.tubes, state.model?.tubes.find((t) => t.id === num(id))),
   playTrajectory: () => ui.bar?.play(),
 };

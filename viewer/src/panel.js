@@ -1,6 +1,6 @@
 // Side panel: header, frame stepper, summary, tables (tubes, plans, counts, timings), display controls.
 import { el, fmt, seconds, int, table, kvTable } from './dom.js';
-import { num } from './data.js';
+import { num, graphText } from './data.js';
 import { tubeColour, OCCLUSION_COLOURS } from './tubes.js';
 
 export const LAYERS = ['cloud', 'bin', 'tubes', 'grasps', 'trajectory', 'placement'];
@@ -72,11 +72,19 @@ function tubesTable(m, h) {
   const rows = m.tubes.map((t) => el('tr', { 'data-tube-id': t.id, onclick: () => h.onSelectTube(t.id) },
     el('td', {}, el('span', { class: 'swatch', style: `background:${tubeColour(t.id)}` }), t.id),
     el('td', { class: 'num' }, fmt(t.length)),
+    graphCell(t),
     el('td', {}, el('span', { class: `badge occ-${t.occlusion}` }, t.occlusion)),
     el('td', { class: 'num' }, t.occludedJointCount),
     el('td', { class: 'num' }, planCount(t.id))));
-  return table('tubes', [{ label: 'tube' }, { label: 'length m', num: 1 }, { label: 'occlusion' },
+  return table('tubes', [{ label: 'tube' }, { label: 'length m', num: 1 },
+    { label: 'shape', title: 'branches (br) and junctions (jn: T/Y pieces) of the tube; linear: one branch' }, { label: 'occlusion' },
     { label: 'occl. joints', num: 1, title: 'occluded joints' }, { label: 'plans', num: 1 }], rows);
+}
+
+/** "linear" (muted) or "5 br, 2 jn"; the title spells it out. */
+function graphCell(t) {
+  const text = graphText(t, true);
+  return el('td', { class: text === 'linear' ? 'graph linear' : 'graph', 'data-field': 'graph', title: graphText(t) }, text);
 }
 
 function plansTable(m, h) {

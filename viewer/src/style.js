@@ -30,6 +30,7 @@ table { width:100%; border-collapse:collapse; font-variant-numeric:tabular-nums;
 th { text-align:left; color:var(--muted); font-weight:600; font-size:11px; padding:3px 5px; border-bottom:1px solid var(--line); white-space:nowrap; }
 td { padding:3px 5px; border-bottom:1px solid #232933; white-space:nowrap; }
 td.num, th.num { text-align:right; }
+td.graph.linear { color:var(--muted); }
 .kv td:first-child { color:var(--muted); }
 .kv td:last-child { text-align:right; }
 tr[data-plan-index], tr[data-tube-id] { cursor:pointer; }
@@ -77,6 +78,7 @@ input[type=range] { accent-color:var(--accent); width:100%; }
 .pd-rank { font-size:15px; font-weight:700; }
 .pd-head .meta { margin-right:auto; margin-left:-3px; }
 .pd-tube { font-weight:600; }
+.pd-graph { color:var(--muted); font-size:12px; margin-left:-4px; }
 .badge.kind { background:#16303a; color:#7dd3fc; }
 .pd-grid { display:grid; grid-template-columns:auto 1fr; gap:4px 14px; font-size:12px; }
 .pd-grid .k { color:var(--muted); white-space:nowrap; }

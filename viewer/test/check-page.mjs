@@ -37,13 +37,29 @@ function pageData(html) {
   return JSON.parse(m[1]);
 }
 
+/**
+ * A tube's graph from its JSON: branch and junction (node of ≥ 3 branches) counts and the junction positions.
+ * proto3 JSON omits zeros (a missing fromNode is node 0); a tube with no branches is linear: 1 branch, 2 free ends.
+ */
+function tubeGraph(t) {
+  const cylinders = Array.isArray(t.cylinders) ? t.cylinders.length : 0;
+  if (!nonEmpty(t.branches)) return { branches: cylinders ? 1 : 0, junctions: 0, junctionPoints: [] };
+  const degree = new Map();
+  const bump = (i) => degree.set(num(i), (degree.get(num(i)) || 0) + 1);
+  for (const b of t.branches) { bump(b.fromNode); bump(b.toNode); }
+  const at = [...degree].filter(([, d]) => d >= 3).map(([i]) => i);
+  const pos = (i) => ['x', 'y', 'z'].map((k) => num(t.nodes?.[i]?.position?.[k]));
+  return { branches: t.branches.length, junctions: at.length, junctionPoints: at.map(pos) };
+}
+
 /** Expected per-frame counts and grasp positions, computed independently from the page's embedded JSON. */
 function expectedFrames(data) {
   return data.frames.map((f) => {
     const tubes = f.plan ? nonEmpty(f.plan.tubes) || nonEmpty(f.plan.modeling?.tubes) || [] : nonEmpty(f.modeling?.tubes) || [];
     const plans = Array.isArray(f.plan?.plans) ? f.plan.plans : [];
     const grasp = (p) => ['x', 'y', 'z'].map((k) => num(p.grasp?.tcpPose?.position?.[k]));
-    return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)), grasps: plans.map(grasp) };
+    return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)), grasps: plans.map(grasp),
+      graphs: tubes.map(tubeGraph) };
   });
 }
 
@@ -151,6 +167,58 @@ async function checkCanvasPick(page, id) {
   check(st !== null, `  3-D pick tube ${id}`, `clicked (${pt.x.toFixed(0)}, ${pt.y.toFixed(0)}) → selectedTubeId=${st}${exact ? '' : ' (occluded: another tube picked)'}`);
 }
 
+/** The shape cell of a tube row: "linear" → 1 branch, 0 junctions; "5 br, 2 jn"; "–" (no cylinders) → 0, 0. */
+function parseGraphCell(text) {
+  const t = (text || '').trim();
+  if (t === 'linear') return { branches: 1, junctions: 0 };
+  if (t === '–') return { branches: 0, junctions: 0 };
+  const m = t.match(/^(\d+) br, (\d+) jn$/);
+  return m ? { branches: Number(m[1]), junctions: Number(m[2]) } : null;
+}
+
+/** Per tube: branches and junctions in its table row and in tubeGraph(id) (read and drawn) equal the JSON's. */
+async function checkGraphs(page, f, i) {
+  const got = await page.evaluate((ids) => ids.map((id) => ({
+    cell: document.querySelector(`#tubes tr[data-tube-id="${id}"] [data-field="graph"]`)?.textContent ?? null,
+    api: window.tubepickViewer.tubeGraph?.(id) ?? null, // a bundle without it fails below, not the run
+  })), f.tubeIds);
+  const bad = [], badDrawn = [];
+  got.forEach((g, k) => {
+    const want = f.graphs[k], id = f.tubeIds[k], shown = parseGraphCell(g.cell);
+    const same = (x) => x && x.branches === want.branches && x.junctions === want.junctions;
+    if (!same(shown) || !same(g.api)) {
+      bad.push(`tube ${id}: row ${g.cell == null ? 'cell missing' : `"${g.cell}"`}, tubeGraph ${g.api ? `${g.api.branches}/${g.api.junctions}` : 'missing'}, JSON ${want.branches}/${want.junctions}`);
+    }
+    if (g.api?.drawn.junction !== want.junctions) badDrawn.push(`tube ${id}: ${g.api ? g.api.drawn.junction : 'no'} spheres, JSON ${want.junctions}`);
+  });
+  const branched = f.graphs.filter((g) => g.branches > 1);
+  const sum = (key) => f.graphs.reduce((s, g) => s + g[key], 0);
+  const some = (list) => list.slice(0, 6).join('; ') + (list.length > 6 ? `; + ${list.length - 6} more` : '');
+  check(!bad.length, `frame ${i + 1}: branches and junctions per tube`, bad.length ? some(bad)
+    : `${f.tubeIds.length} tube rows and tubeGraph() match the JSON: ${!f.tubeIds.length ? 'no tubes' : branched.length
+      ? `${branched.length} branched (${sum('branches')} branches, ${sum('junctions')} junctions in all)` : 'all linear'}`);
+  check(!badDrawn.length, `frame ${i + 1}: a junction sphere per junction`, badDrawn.length ? some(badDrawn)
+    : `${sum('junctions')} drawn`);
+}
+
+/** A click on a junction node (projected from the JSON) selects its tube; the first unoccluded one of up to 12 counts. */
+async function checkJunctionPick(page, f) {
+  const tries = f.graphs.flatMap((g, k) => g.junctionPoints.map((p) => ({ id: f.tubeIds[k], p }))).slice(0, 12);
+  if (!tries.length) return;
+  for (const { id, p } of tries) {
+    const s = await api(page, `v.screenPoint(${JSON.stringify(p)})`);
+    const onCanvas = await page.evaluate(([x, y]) => document.elementFromPoint(x, y)?.tagName === 'CANVAS', [s.x, s.y]);
+    if (!onCanvas) continue;
+    await page.keyboard.press('Escape');
+    await page.mouse.click(s.x, s.y);
+    await settle(page);
+    if (await api(page, 'v.selectedTubeId') !== id) continue;
+    check(true, `  3-D pick at a junction of tube ${id}`, `clicked (${s.x.toFixed(0)}, ${s.y.toFixed(0)}) → selectedTubeId=${id}`);
+    return;
+  }
+  check(false, '  3-D pick at a junction', `none of ${tries.length} junction nodes selected its tube (all occluded or off the canvas)`);
+}
+
 async function checkFrame(page, f, i) {
   await api(page, `v.showFrame(${i})`);
   await settle(page);
@@ -163,11 +231,13 @@ async function checkFrame(page, f, i) {
   const nt = f.tubeIds.length, np = f.planTubeIds.length;
   check(got.idx === i && got.tubes === nt && got.tubeRows === nt && got.plans === np && got.planRows === np,
     `frame ${i + 1}: counts`, `tubeCount ${got.tubes}, tube rows ${got.tubeRows} (JSON ${nt}); planCount ${got.plans}, plan rows ${got.planRows} (JSON ${np})`);
+  await checkGraphs(page, f, i);
   const planIdx = [...new Set([0, np - 1])].filter((k) => k >= 0 && k < np);
   for (const k of planIdx) await checkPlanClick(page, f, k);
   const tubeIds = [f.tubeIds[0], f.planTubeIds[0], f.tubeIds[nt - 1]].filter((x) => x !== undefined && f.tubeIds.includes(x));
   for (const id of new Set(tubeIds)) await checkTubeClick(page, f, id);
   if (nt) await checkCanvasPick(page, np ? f.planTubeIds[0] : f.tubeIds[0]);
+  await checkJunctionPick(page, f);
 }
 
 const PRESETS = ['top', 'front', 'side', '3/4'];
@@ -287,7 +357,9 @@ async function checkViewerPage(page, url, consoleErrors) {
     for (let i = 0; i < frames.length; i++) await checkFrame(page, frames[i], i);
     await exercise(page, frames);
   }
-  check(consoleErrors.length === 0, 'no console or page errors', consoleErrors.length ? consoleErrors.join(' | ') : '0 errors');
+  const branched = frames.reduce((s, f) => s + f.graphs.filter((g) => g.branches > 1).length, 0);
+  check(consoleErrors.length === 0, 'no console or page errors', (consoleErrors.length ? consoleErrors.join(' | ') : '0 errors')
+    + (branched ? ` (the page has ${branched} branched tube(s))` : ''));
 }
 
 async function followList(page, url, consoleErrors) {

@@ -38,3 +38,49 @@ TEST(ProtoConvertTest, CellDescriptionCarriesTheCaptureSensorPose) {
 
 }  // namespace
 }  // namespace tubepick
+
+namespace tubepick {
+namespace {
+
+Cylinder TestCylinder(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  Cylinder c;
+  c.start = a;
+  c.end = b;
+  c.radius = 0.0125;
+  return c;
+}
+
+TEST(ProtoConvertTest, ALinearTubeGoesOutAsOneBranchBetweenTwoEnds) {
+  Tube t;
+  t.id = 4;
+  t.cylinders = {TestCylinder({0, 0, 0}, {0.1, 0, 0}), TestCylinder({0.12, 0, 0}, {0.2, 0, 0})};
+  const v1::Tube out = ToProto(t);
+  ASSERT_EQ(out.branches_size(), 1);
+  EXPECT_EQ(out.branches(0).from_node(), 0u);
+  EXPECT_EQ(out.branches(0).to_node(), 1u);
+  EXPECT_EQ(out.branches(0).first_cylinder(), 0u);
+  EXPECT_EQ(out.branches(0).cylinder_count(), 2u);
+  ASSERT_EQ(out.nodes_size(), 2);
+  EXPECT_DOUBLE_EQ(out.nodes(1).position().x(), 0.2);
+  EXPECT_NEAR(out.length(), 0.2, 1e-12);
+}
+
+TEST(ProtoConvertTest, ABranchedTubeCarriesItsNodesAndBranches) {
+  Tube t;
+  t.cylinders = {TestCylinder({0, 0, 0}, {0.1, 0, 0}), TestCylinder({0.1, 0, 0}, {0.2, 0, 0}),
+                 TestCylinder({0.1, 0.03, 0}, {0.1, 0.13, 0})};
+  t.nodes = {TubeNode{{0, 0, 0}}, TubeNode{{0.1, 0, 0}}, TubeNode{{0.2, 0, 0}}, TubeNode{{0.1, 0.13, 0}}};
+  t.branches = {TubeBranch{0, 1, 0, 1}, TubeBranch{1, 2, 1, 1}, TubeBranch{1, 3, 2, 1}};
+  const v1::Tube out = ToProto(t);
+  ASSERT_EQ(out.nodes_size(), 4);
+  ASSERT_EQ(out.branches_size(), 3);
+  EXPECT_EQ(out.branches(2).from_node(), 1u);
+  EXPECT_EQ(out.branches(2).to_node(), 3u);
+  EXPECT_EQ(out.branches(2).first_cylinder(), 2u);
+  EXPECT_EQ(out.branches(2).cylinder_count(), 1u);
+  EXPECT_DOUBLE_EQ(out.nodes(3).position().y(), 0.13);
+  EXPECT_NEAR(out.length(), 0.2 + 0.03 + 0.1, 1e-12);  // the junction link counts
+}
+
+}  // namespace
+}  // namespace tubepick

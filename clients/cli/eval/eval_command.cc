@@ -39,7 +39,8 @@ struct EvalOptions {
   std::uint32_t per_count = 20;
   std::string preset = "A";
   std::string report_dir;
-  std::string joining;  // "", "greedy", "global"
+  std::string joining;   // "", "greedy", "global"
+  std::string topology;  // "", "linear", "branched", "auto"
   std::uint32_t jobs = 1;
   std::uint32_t pictures_per_count = 2;
   /// Cloud points of each scene's 3-D page; 0 = no pages.
@@ -281,7 +282,12 @@ void Run(const EvalOptions& o) {
   const auto t_start = Clock::now();
   const int sources = !o.scenes_dir.empty() + !o.generate.empty() + !o.configs_dir.empty();
   if (sources != 1) throw InvalidArgument("eval: give exactly one of --scenes, --generate, --configs");
-  const CellConfig cell = LoadCell(o.common);
+  CellConfig cell = LoadCell(o.common);
+  if (!o.topology.empty()) {
+    cell.tube.topology = ParseTubeTopology(o.topology, "--topology");
+  } else if (!o.generate.empty()) {
+    cell = CellForPreset(cell, o.preset);
+  }
   Params params = LoadParamsFor(o.common);
   if (o.joining == "greedy") params.modeling.joining.strategy = JoiningStrategy::kGreedy;
   if (o.joining == "global") params.modeling.joining.strategy = JoiningStrategy::kGlobal;
@@ -298,13 +304,14 @@ void Run(const EvalOptions& o) {
   run.profile = o.common.profile;
   run.params_path = o.common.params_path;
   run.joining_strategy = params.modeling.joining.strategy == JoiningStrategy::kGlobal ? "global" : "greedy";
+  run.topology = ToString(cell.tube.topology);
   run.params_yaml = DumpParams(params);
   run.evaluation_params = eval_params;
   run.modeling_seed = o.common.seed;
   run.jobs = jobs;
   run.modeling_threads = params.modeling.threads;
-  fmt::print(stderr, "eval: {} scenes ({}), profile {}, joining {}, {} job(s)\n", scene_jobs.size(),
-             run.source, run.profile, run.joining_strategy, jobs);
+  fmt::print(stderr, "eval: {} scenes ({}), profile {}, joining {}, topology {}, {} job(s)\n",
+             scene_jobs.size(), run.source, run.profile, run.joining_strategy, run.topology, jobs);
 
   // Every scene is independent and fully seeded: results land in input order whatever the
   // number of workers, so the report does not depend on --jobs (timings aside).
@@ -402,6 +409,10 @@ void AddEvalCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--joining", o->joining, "Override the joining strategy")
       ->check(CLI::IsMember({"greedy", "global"}));
+  cmd->add_option("--topology", o->topology,
+                  "Override the cell's tube.topology (default: the cell's; generated branched presets "
+                  "model a linear cell's tubes as branched)")
+      ->check(CLI::IsMember({"linear", "branched", "auto"}));
   cmd->add_option("--report", o->report_dir, "Directory for report.md, report.json and images/")->required();
   cmd->add_option(
          "--jobs", o->jobs,

@@ -52,6 +52,8 @@ struct EvalRun {
   std::string profile;
   std::string params_path;
   std::string joining_strategy;
+  /// The tube topology modeled ("linear", "branched", "auto").
+  std::string topology = "linear";
   /// The full params YAML used (DumpParams).
   std::string params_yaml;
   EvaluationParams evaluation_params;

@@ -126,6 +126,7 @@ std::string FormatJsonReport(const EvalRun& run, const std::vector<ReportImage>&
   j["profile"] = run.profile;
   j["params_file"] = run.params_path;
   j["joining_strategy"] = run.joining_strategy;
+  j["topology"] = run.topology;
   j["modeling_seed"] = run.modeling_seed;
   j["jobs"] = run.jobs;
   j["modeling_threads"] = run.modeling_threads;

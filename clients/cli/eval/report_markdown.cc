@@ -43,9 +43,9 @@ std::string FormatMarkdownReport(const EvalRun& run, const std::vector<ReportIma
         "- 3-D pages: `views/SCENE.html`, one per scene (its cloud and modeled tubes; open in a browser, "
         "no network needed); the scene names below link them\n";
   }
-  md += fmt::format("- Modeling: profile `{}`{}, joining `{}`, modeling seed {}\n", run.profile,
-                    run.params_path.empty() ? "" : fmt::format(" + `{}`", run.params_path),
-                    run.joining_strategy, run.modeling_seed);
+  md += fmt::format("- Modeling: profile `{}`{}, joining `{}`, topology `{}`, modeling seed {}\n",
+                    run.profile, run.params_path.empty() ? "" : fmt::format(" + `{}`", run.params_path),
+                    run.joining_strategy, run.topology, run.modeling_seed);
   md += fmt::format(
       "- Run: {} concurrent job(s){}, wall time {:.1f} s ({:.2f} s per scene: simulation or loading, "
       "scan, modeling, evaluation)\n\n",

@@ -7,6 +7,7 @@
 
 #include "clients/cli/eval/eval_report.h"
 #include "clients/cli/eval/svg_util.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick::cli {
 namespace {
@@ -235,19 +236,13 @@ std::string RenderSceneSvg(const EvaluatedScene& scene) {
     svg += PointPaths(p, s, colours, 0.55);
     for (std::size_t v = 0; v < s.tubes.size(); ++v) {
       const auto& cyl = s.tubes[v].cylinders;
-      for (std::size_t c = 0; c < cyl.size(); ++c) {
+      for (const AxisPiece& piece : TubeAxisPieces(s.tubes[v])) {
+        // Cylinders solid, joints (and junction links) dashed.
         svg += fmt::format(
-            "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#111\" "
-            "stroke-width=\"4\" "
-            "stroke-linecap=\"round\"/>\n",
-            p.X(cyl[c].start.x()), p.Y(cyl[c].start.y()), p.X(cyl[c].end.x()), p.Y(cyl[c].end.y()));
-        if (c + 1 < cyl.size()) {
-          svg += fmt::format(
-              "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#111\" "
-              "stroke-width=\"2.5\" "
-              "stroke-dasharray=\"6 5\"/>\n",
-              p.X(cyl[c].end.x()), p.Y(cyl[c].end.y()), p.X(cyl[c + 1].start.x()), p.Y(cyl[c + 1].start.y()));
-        }
+            "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#111\" {}/>\n",
+            p.X(piece.a.x()), p.Y(piece.a.y()), p.X(piece.b.x()), p.Y(piece.b.y()),
+            piece.cylinder >= 0 ? "stroke-width=\"4\" stroke-linecap=\"round\""
+                                : "stroke-width=\"2.5\" stroke-dasharray=\"6 5\"");
       }
       if (cyl.empty()) continue;
       const VirtualTubeEvaluation& ve = e.virtual_tubes[v];

@@ -62,6 +62,7 @@ ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, co
   input.unit = unit;
   input.X_BinSensor = cell.sensor.X_BinSensor;
   input.bin = cell.bin;
+  input.topology = cell.tube.topology;
   input.seed = seed;
   return input;
 }

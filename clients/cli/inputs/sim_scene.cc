@@ -4,6 +4,17 @@
 
 namespace tubepick::cli {
 
+CellConfig CellForPreset(CellConfig cell, const std::string& preset) {
+  const physics::RandomTubeParams tubes = physics::RandomTubeParams::Preset(preset);
+  double length = 0.0;
+  for (const physics::TubeBranchSpec& b : tubes.branches) length += b.length;
+  cell.tube.length = length;
+  if (tubes.branches.size() > 1 && cell.tube.topology == TubeTopology::kLinear) {
+    cell.tube.topology = TubeTopology::kBranched;
+  }
+  return cell;
+}
+
 SimulatedScene SimulateScene(const CellConfig& cell, int tube_count, const std::string& preset,
                              std::uint64_t seed) {
   physics::SceneParams params;

@@ -16,6 +16,11 @@ struct SimulatedScene {
   physics::ScanResult scan;
 };
 
+/// The cell that describes `preset`'s tubes: tube.length is the preset's total curve length, and
+/// a branched preset (C) makes a linear cell's topology branched (an `auto` cell stays auto).
+/// @throws InvalidArgument for an unknown preset.
+CellConfig CellForPreset(CellConfig cell, const std::string& preset);
+
 /// `tube_count` tubes of `preset` ("A", "B", "C"; radius and mass from the cell) dropped into
 /// the cell's bin and scanned with the default scanner, all driven by `seed`. With preset A this
 /// is the same scene as the built-in one of `tubepick model --tubes N --seed S`.

@@ -101,6 +101,7 @@ Stages InProcessCall(const BenchCloud& cloud, const Params& params, std::uint32_
   input.xyz_Sensor = PackedXyz{xyz};
   input.X_BinSensor = cell.sensor.X_BinSensor;
   input.bin = cell.bin;
+  input.topology = cell.tube.topology;
   input.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
   ModelingParams modeling_params = params.modeling;
   modeling_params.threads = threads;

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "clients/cli/inputs/cli_inputs.h"
+#include "core/common/tube_graph.h"
 #include "core/modeling/model_tubes.h"
 #include "wire/proto_convert.h"
 #include "wire/response_convert.h"
@@ -25,12 +26,18 @@ void PrintSummary(const ModelingResult& r, const std::string& source) {
       "s\n",
       r.input_points, r.dropped_non_finite, r.filtered.size(), r.segment_count, r.cylinder_count,
       r.tubes.size(), r.total_seconds);
-  fmt::print("{:>5} {:>9} {:>9}  {:<30} {:<30}\n", "tube", "length_m", "cylinders", "end A (x, y, z) m",
-             "end B (x, y, z) m");
+  fmt::print("{:>5} {:>9} {:>8} {:>9}  {}\n", "tube", "length_m", "branches", "cylinders",
+             "nodes: ends, then junctions (x, y, z) m");
   for (const Tube& t : r.tubes) {
-    const Eigen::Vector3d a = t.cylinders.front().start, b = t.cylinders.back().end;
-    fmt::print("{:>5} {:>9.3f} {:>9}  ({:+.3f}, {:+.3f}, {:+.3f})       ({:+.3f}, {:+.3f}, {:+.3f})\n", t.id,
-               t.length(), t.cylinders.size(), a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+    const std::vector<TubeNode> nodes = NodesOf(t);
+    const std::vector<std::uint32_t> degree = NodeDegrees(t);
+    std::string ends, junctions;
+    for (std::size_t n = 0; n < nodes.size(); ++n) {
+      const Eigen::Vector3d& p = nodes[n].p_Bin;
+      (degree[n] == 1 ? ends : junctions) += fmt::format(" ({:+.3f}, {:+.3f}, {:+.3f})", p.x(), p.y(), p.z());
+    }
+    fmt::print("{:>5} {:>9.3f} {:>8} {:>9} {}{}\n", t.id, t.length(), BranchesOf(t).size(),
+               t.cylinders.size(), ends, junctions.empty() ? "" : "  junctions:" + junctions);
   }
   fmt::print("stages:");
   for (const StageTiming& s : r.timings) fmt::print(" {} {:.1f} ms;", s.stage, 1e3 * s.seconds);

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "clients/cli/inputs/cli_inputs.h"
+#include "core/common/tube_graph.h"
 #include "core/modeling/model_tubes.h"
 #include "core/planning/pick_planner.h"
 #include "core/planning/plan_placement.h"
@@ -50,9 +51,10 @@ void Run(const PlanOptions& o) {
   fmt::print("modeling {:.3f} s: {} tubes; planning {:.3f} s: {} plans{}{}\n", modeling.total_seconds,
              modeling.tubes.size(), plan.total_seconds, plan.plans.size(),
              plan.used_simulation ? " (trajectories simulated)" : "", plan.bin_empty ? "; BIN EMPTY" : "");
-  fmt::print("{:>5} {:>9} {:>9}\n", "tube", "length_m", "occlusion");
+  fmt::print("{:>5} {:>9} {:>8} {:>9}\n", "tube", "length_m", "branches", "occlusion");
   for (const Tube& t : plan.tubes)
-    fmt::print("{:>5} {:>9.3f} {:>9}\n", t.id, t.length(), OcclusionName(t.occlusion));
+    fmt::print("{:>5} {:>9.3f} {:>8} {:>9}\n", t.id, t.length(), BranchesOf(t).size(),
+               OcclusionName(t.occlusion));
   fmt::print("{:>4} {:>5} {:>17} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
              "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
   for (std::size_t i = 0; i < plan.plans.size() && i < o.show; ++i) {

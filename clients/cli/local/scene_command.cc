@@ -24,7 +24,8 @@ struct SceneOptions {
 };
 
 void Run(const SceneOptions& o) {
-  const CellConfig cell = LoadCell(o.common);
+  // The cell written with the scene describes its tubes (length, topology).
+  const CellConfig cell = CellForPreset(LoadCell(o.common), o.preset);
   const auto t0 = std::chrono::steady_clock::now();
   SimulatedScene scene = SimulateScene(cell, o.tubes, o.preset, o.common.seed);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

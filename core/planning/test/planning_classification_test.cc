@@ -7,7 +7,10 @@
 #include <gtest/gtest.h>
 
 #include "core/common/errors.h"
+#include "core/common/tube_graph.h"
+#include "core/planning/grasp_ranking.h"
 #include "core/planning/test/planning_test_util.h"
+#include "core/planning/trajectory_synthesis.h"
 
 namespace tubepick {
 namespace {
@@ -124,6 +127,71 @@ TEST(Classification, RejectsNegativeTolerance) {
   } catch (const InvalidArgument& e) {
     EXPECT_THAT(e.what(), HasSubstr("planning.classification.length_tolerance"));
   }
+}
+
+}  // namespace
+}  // namespace tubepick
+
+namespace tubepick {
+namespace {
+
+// A tee: a run along x cut at x = 0.10, and a branch along y starting `link` from the node.
+Tube Tee(double link) {
+  Tube t;
+  auto cyl = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::uint32_t segment) {
+    Cylinder c;
+    c.start = a;
+    c.end = b;
+    c.radius = 0.0125;
+    c.segment_id = segment;
+    return c;
+  };
+  t.cylinders = {cyl({0, 0, 0.0125}, {0.10, 0, 0.0125}, 0), cyl({0.10, 0, 0.0125}, {0.20, 0, 0.0125}, 0),
+                 cyl({0.10, link, 0.0125}, {0.10, link + 0.10, 0.0125}, 1)};
+  t.nodes = {TubeNode{{0, 0, 0.0125}}, TubeNode{{0.10, 0, 0.0125}}, TubeNode{{0.20, 0, 0.0125}},
+             TubeNode{{0.10, link + 0.10, 0.0125}}};
+  t.branches = {TubeBranch{0, 1, 0, 1}, TubeBranch{1, 2, 1, 1}, TubeBranch{1, 3, 2, 1}};
+  return t;
+}
+
+TEST(ClassificationOfBranchedTubes, AJunctionLinkIsOccludedOnlyWhenLongerThanARadiusPlusTheGap) {
+  ClassificationParams params;  // junction_gap 0.02: links up to 0.0325 m are a junction seen whole
+  EXPECT_TRUE(OccludedJoints(Tee(0.03), params).empty());
+  EXPECT_EQ(OccludedJoints(Tee(0.05), params), (std::vector<std::uint32_t>{0}));
+  params.junction_gap = 0.05;
+  EXPECT_TRUE(OccludedJoints(Tee(0.05), params).empty());
+  const ClassificationResult result = ClassifyTubes({Tee(0.05)}, 0.0, ClassificationParams{});
+  EXPECT_EQ(result.classes[0].occlusion, Occlusion::kWeak);
+}
+
+TEST(ClassificationOfBranchedTubes, ABranchedTubeIsLiftedStraightUpOnly) {
+  const Tube tee = Tee(0.05);
+  const ClassificationResult result = ClassifyTubes({tee}, 0.0, ClassificationParams{});
+  SafetyZone zone;
+  zone.min = Eigen::Vector2d(-0.4, -0.3);
+  zone.max = Eigen::Vector2d(0.4, 0.3);
+  const std::vector<Trajectory> trajectories =
+      SynthesizeTrajectories(0, result.tubes[0], result.classes[0], 0.0125, zone, TrajectoryParams{});
+  ASSERT_EQ(trajectories.size(), 1u);
+  EXPECT_EQ(trajectories[0].kind, TrajectoryKind::kUpward);
+}
+
+TEST(ClassificationOfBranchedTubes, GraspsNearTheWholeTubesMassCentreCostLess) {
+  const Tube tee = Tee(0.03);
+  const Eigen::Vector3d centre = TubeMassCentre(tee);
+  Grasp near, far;
+  near.p_Bin_grasp = Eigen::Vector3d(0.10, 0.0, 0.0125);  // on the run, under the branch
+  far.p_Bin_grasp = Eigen::Vector3d(0.01, 0.0, 0.0125);   // at the run's end
+  EXPECT_LT(GraspCentreCost(near, tee), 0.3);
+  EXPECT_GT(GraspCentreCost(far, tee), 0.6);
+  EXPECT_NEAR(GraspCentreCost(near, tee), MassCentreCost(near.p_Bin_grasp, tee), 0.0);
+  EXPECT_NEAR(MassCentreCost(centre, tee), 0.0, 1e-12);
+  // A linear tube keeps the along-curve cost of the thesis.
+  Tube run;
+  run.cylinders = {tee.cylinders[0], tee.cylinders[1]};
+  Grasp middle;
+  middle.curve_position = 0.10;
+  EXPECT_NEAR(GraspCentreCost(middle, run), 0.0, 1e-12);
 }
 
 }  // namespace

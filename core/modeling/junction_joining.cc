@@ -1,0 +1,553 @@
+// Junction joining: linear chains (JoinTubes) into trees.
+//
+// A branch of a hose assembly leaves its run at a T- or Y-piece. Region growing splits the
+// surface there (the normals turn), so the cylinders near the node end a centimetre or more from
+// it, pointing at it; the blob at the node itself is often a short fragment of its own.
+// Three kinds of node, accepted in this order:
+// 1. Y-pieces (every branch ends at the node): free ends whose axes, each extended by its
+//    radius plus max_gap, meet within max_axis_offset, at an angle of at least min_angle or
+//    facing each other along one line (a run broken at the node), are clustered cheapest first;
+//    a cluster of min_meeting_ends (3) or more ends within node_spacing of its centre is a node.
+// 2. T-pieces (the run goes on through the node): a free end whose axis, extended by the other
+//    tube's radius plus side_max_gap, passes within side_max_axis_offset of another chain's axis
+//    (a cylinder or a joint of it), at least min_angle off it and not within node_spacing of
+//    that chain's free ends. A tube lying across another is not one: its axis passes about two
+//    radii above the other's. The chain is cut there (the cylinder under the node is split at
+//    the foot; T-nodes closer than node_spacing on one chain share a node).
+// 3. Links: two ends that met alone in step 1 and lie within link_max_distance and link_max_angle
+//    (α + β, as the linear joining) are joined end to end (the node is then dropped again,
+//    WithoutPassThroughNodes).
+// Each is accepted only while every tube stays a tree (union-find over chains), each free end is
+// used once, no node exceeds max_branches_per_node and no tube max_tube_length.
+
+#include "core/modeling/junction_joining.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <tuple>
+
+#include "core/common/errors.h"
+#include "core/common/require.h"
+#include "core/common/segment_geometry.h"
+#include "core/common/tube_graph.h"
+
+namespace tubepick {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A cylinder is split only when both halves are at least this long, metres; otherwise the cut
+// moves to its nearer end.
+constexpr double kMinPiece = 0.002;
+
+// A chain's free end: its position and the outward direction of its axis.
+struct FreeEnd {
+  Eigen::Vector3d p;
+  Eigen::Vector3d out;
+};
+
+FreeEnd EndOf(const Tube& chain, bool at_end) {
+  const Cylinder& c = at_end ? chain.cylinders.back() : chain.cylinders.front();
+  return at_end ? FreeEnd{c.end, c.axis()} : FreeEnd{c.start, -c.axis()};
+}
+
+// Arc length along a chain's axis pieces at a position (piece index + fraction).
+double ArcAt(const std::vector<AxisPiece>& pieces, double position) {
+  const auto k = static_cast<std::size_t>(position);
+  double arc = 0.0;
+  for (std::size_t i = 0; i < k && i < pieces.size(); ++i) arc += (pieces[i].b - pieces[i].a).norm();
+  if (k < pieces.size()) arc += (position - static_cast<double>(k)) * (pieces[k].b - pieces[k].a).norm();
+  return arc;
+}
+
+double ArcLength(const std::vector<AxisPiece>& pieces) {
+  return ArcAt(pieces, static_cast<double>(pieces.size()));
+}
+
+class Forest {
+ public:
+  explicit Forest(const std::vector<Tube>& chains) : parent_(chains.size()), length_(chains.size()) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+    for (std::size_t i = 0; i < chains.size(); ++i) length_[i] = chains[i].length();
+  }
+  std::uint32_t Find(std::uint32_t i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  double Length(std::uint32_t i) { return length_[Find(i)]; }
+  void AddLength(std::uint32_t i, double length) { length_[Find(i)] += length; }
+  void Unite(std::uint32_t a, std::uint32_t b, double link) {
+    a = Find(a);
+    b = Find(b);
+    if (a > b) std::swap(a, b);
+    parent_[b] = a;
+    length_[a] += length_[b] + link;
+  }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+  std::vector<double> length_;
+};
+
+// Two free ends whose extended axes meet (a pair of a Y-piece's branches).
+struct EndMeeting {
+  std::pair<std::uint32_t, bool> a;  // (chain, at_end)
+  std::pair<std::uint32_t, bool> b;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  double cost = 0.0;
+  // Close and straight enough to be linked end to end when no third end meets them.
+  bool linkable = false;
+};
+
+// Free ends meeting at one node: a Y-piece, where every branch ends at the junction.
+struct MeetingNode {
+  std::vector<std::pair<std::uint32_t, bool>> ends;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int points = 0;
+  double cost = 0.0;
+  bool linkable = false;
+
+  Eigen::Vector3d Centre() const { return sum / points; }
+};
+
+// Pairs of free ends of different chains whose axes, each extended by at most its radius plus
+// max_gap, pass within max_axis_offset of each other at an angle of at least min_angle, or that
+// face each other along one line within that reach (a run broken at a T-piece's node; alone,
+// such a pair is the linear joining's business, so only a third end makes it a node). Ends
+// pointing the same way side by side never meet. Cheapest first.
+std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const JunctionParams& params) {
+  const double cos_min = std::cos(params.min_angle);
+  struct End {
+    std::pair<std::uint32_t, bool> id;
+    FreeEnd end;
+    double reach;
+  };
+  std::vector<End> ends;
+  for (std::uint32_t c = 0; c < chains.size(); ++c) {
+    if (chains[c].cylinders.empty() || chains[c].branched()) continue;
+    for (const bool at_end : {false, true}) {
+      const double radius = (at_end ? chains[c].cylinders.back() : chains[c].cylinders.front()).radius;
+      ends.push_back({{c, at_end}, EndOf(chains[c], at_end), radius + params.max_gap});
+    }
+  }
+  std::vector<EndMeeting> out;
+  auto linkable = [&](const End& x, const End& y) {
+    const Eigen::Vector3d d = y.end.p - x.end.p;
+    const double distance = d.norm();
+    if (distance > params.link_max_distance) return false;
+    if (distance < 0.5 * (x.reach + y.reach - 2.0 * params.max_gap)) return true;  // touching: any angle
+    const double a = std::atan2(x.end.out.cross(d).norm(), x.end.out.dot(d));
+    const double b = std::atan2(y.end.out.cross(-d).norm(), y.end.out.dot(-d));
+    return a + b <= params.link_max_angle;
+  };
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    for (std::size_t k = i + 1; k < ends.size(); ++k) {
+      const End& x = ends[i];
+      const End& y = ends[k];
+      if (x.id.first == y.id.first) continue;
+      if ((x.end.p - y.end.p).norm() > x.reach + y.reach + params.max_axis_offset) continue;
+      const double alignment = x.end.out.dot(y.end.out);
+      if (alignment > cos_min) continue;  // side by side, pointing the same way
+      if (alignment < -cos_min) {
+        // Facing each other along one line: a run broken at a T-piece's node (or a plain gap,
+        // which only a third end meeting them turns into a node). They meet halfway.
+        const Eigen::Vector3d gap = y.end.p - x.end.p;
+        const double along = gap.dot(x.end.out);
+        const double offset = (gap - along * x.end.out).norm();
+        if (along <= 0.0 || along > x.reach + y.reach || offset > params.max_axis_offset) continue;
+        out.push_back({x.id, y.id, 0.5 * (x.end.p + y.end.p), along + offset, linkable(x, y)});
+        continue;
+      }
+      const SegmentClosestPoints cp = ClosestPointsOfSegments(x.end.p, x.end.p + x.reach * x.end.out, y.end.p,
+                                                              y.end.p + y.reach * y.end.out);
+      if (cp.distance > params.max_axis_offset) continue;
+      const Eigen::Vector3d px = x.end.p + cp.s * x.reach * x.end.out;
+      const Eigen::Vector3d py = y.end.p + cp.t * y.reach * y.end.out;
+      out.push_back(
+          {x.id, y.id, 0.5 * (px + py), cp.s * x.reach + cp.t * y.reach + cp.distance, linkable(x, y)});
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const EndMeeting& u, const EndMeeting& v) {
+    return std::tie(u.cost, u.a, u.b) < std::tie(v.cost, v.a, v.b);
+  });
+  return out;
+}
+
+// A node on a host chain: the junctions that share it.
+struct HostNode {
+  double arc = 0.0;
+  double position = 0.0;  // on the host's axis pieces
+  Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
+  std::uint32_t degree = 2;  // the two halves of the host
+};
+
+struct Accepted {
+  std::vector<Junction> junctions;
+  // Per accepted junction: its host node (index into nodes_of_host[host]).
+  std::vector<std::size_t> node_of_junction;
+  std::map<std::uint32_t, std::vector<HostNode>> nodes_of_host;
+  std::vector<MeetingNode> meetings;
+};
+
+// Groups end meetings, cheapest first, into nodes of free ends whose meeting points lie within
+// node_spacing of the node's centre (one end per chain, at most max_branches_per_node); only
+// nodes of three or more ends are junctions.
+std::vector<MeetingNode> ClusterMeetings(const std::vector<EndMeeting>& meetings,
+                                         const JunctionParams& params) {
+  std::vector<MeetingNode> nodes;
+  std::map<std::pair<std::uint32_t, bool>, std::size_t> node_of_end;
+  auto has_chain = [](const MeetingNode& n, std::uint32_t chain) {
+    return std::any_of(n.ends.begin(), n.ends.end(), [&](const auto& e) { return e.first == chain; });
+  };
+  auto join = [&](std::size_t k, const std::pair<std::uint32_t, bool>& end, const Eigen::Vector3d& p) {
+    MeetingNode& n = nodes[k];
+    if (has_chain(n, end.first) || n.ends.size() >= params.max_branches_per_node) return;
+    if ((p - n.Centre()).norm() > params.node_spacing) return;
+    n.ends.push_back(end);
+    n.sum += p;
+    ++n.points;
+    node_of_end[end] = k;
+  };
+  for (const EndMeeting& m : meetings) {
+    const auto a = node_of_end.find(m.a), b = node_of_end.find(m.b);
+    if (a == node_of_end.end() && b == node_of_end.end()) {
+      nodes.push_back(MeetingNode{{m.a, m.b}, m.p, 1, m.cost, m.linkable});
+      node_of_end[m.a] = node_of_end[m.b] = nodes.size() - 1;
+    } else if (b == node_of_end.end()) {
+      join(a->second, m.b, m.p);
+    } else if (a == node_of_end.end()) {
+      join(b->second, m.a, m.p);
+    }
+  }
+  std::vector<MeetingNode> junctions;
+  for (MeetingNode& n : nodes) {
+    if (n.ends.size() >= params.min_meeting_ends || (n.ends.size() == 2 && n.linkable)) {
+      junctions.push_back(std::move(n));
+    }
+  }
+  return junctions;
+}
+
+Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
+                const std::vector<Junction>& candidates, const JunctionParams& params,
+                const StopToken* stop) {
+  Forest forest(chains);
+  std::vector<std::array<bool, 2>> end_used(chains.size(), {false, false});
+  Accepted out;
+  // Y-pieces first: their ends are spoken for; then T-pieces; then end-to-end links.
+  auto accept_meeting = [&](const MeetingNode& n) {
+    std::vector<std::uint32_t> roots;
+    double links = 0.0;
+    for (const auto& [chain, at_end] : n.ends) {
+      roots.push_back(forest.Find(chain));
+      links += (EndOf(chains[chain], at_end).p - n.Centre()).norm();
+    }
+    std::sort(roots.begin(), roots.end());
+    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return;  // a cycle
+    for (const auto& [chain, at_end] : n.ends) {
+      if (end_used[chain][at_end ? 1 : 0]) return;
+    }
+    double length = links;
+    for (const std::uint32_t r : roots) length += forest.Length(r);
+    if (params.max_tube_length > 0.0 && length > params.max_tube_length) return;
+    for (std::size_t k = 1; k < n.ends.size(); ++k) forest.Unite(n.ends[0].first, n.ends[k].first, 0.0);
+    forest.AddLength(n.ends[0].first, links);
+    for (const auto& [chain, at_end] : n.ends) end_used[chain][at_end ? 1 : 0] = true;
+    out.meetings.push_back(n);
+  };
+  for (const MeetingNode& n : meeting_nodes) {
+    if (n.ends.size() >= 3) accept_meeting(n);
+  }
+  for (const Junction& j : candidates) {
+    ThrowIfStopped(stop, "joining");
+    if (end_used[j.branch][j.at_end ? 1 : 0] || forest.Find(j.branch) == forest.Find(j.host)) continue;
+    const double link = (j.p_Bin - EndOf(chains[j.branch], j.at_end).p).norm();
+    if (params.max_tube_length > 0.0 &&
+        forest.Length(j.branch) + forest.Length(j.host) + link > params.max_tube_length) {
+      continue;
+    }
+    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains[j.host]);
+    const double arc = ArcAt(pieces, j.host_position);
+    std::vector<HostNode>& nodes = out.nodes_of_host[j.host];
+    auto near = std::find_if(nodes.begin(), nodes.end(),
+                             [&](const HostNode& n) { return std::abs(n.arc - arc) < params.node_spacing; });
+    if (near != nodes.end() && near->degree + 1 > params.max_branches_per_node) continue;
+    if (near == nodes.end() && 3 > params.max_branches_per_node) continue;
+    if (near == nodes.end()) {
+      nodes.push_back(HostNode{arc, j.host_position, j.p_Bin, 2});
+      near = nodes.end() - 1;
+    }
+    ++near->degree;
+    end_used[j.branch][j.at_end ? 1 : 0] = true;
+    forest.Unite(j.branch, j.host, link);
+    out.junctions.push_back(j);
+    out.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
+  }
+  for (const MeetingNode& n : meeting_nodes) {
+    if (n.ends.size() == 2) accept_meeting(n);
+  }
+  return out;
+}
+
+// Builds one tree from the chains of a component and the junctions among them.
+class TreeBuilder {
+ public:
+  TreeBuilder(const std::vector<Tube>& chains, const Accepted& accepted)
+      : chains_(chains), accepted_(accepted) {}
+
+  Tube Build(const std::vector<std::uint32_t>& members) {
+    tube_ = Tube{};
+    node_id_.clear();
+    // Nodes of the junctions first (Y-pieces, then in host order), so that branch ends can name
+    // them.
+    for (std::size_t k = 0; k < accepted_.meetings.size(); ++k) {
+      const MeetingNode& n = accepted_.meetings[k];
+      if (std::find(members.begin(), members.end(), n.ends.front().first) == members.end()) continue;
+      node_id_[{kMeeting, k}] = static_cast<std::uint32_t>(tube_.nodes.size());
+      tube_.nodes.push_back(TubeNode{n.Centre()});
+    }
+    for (const std::uint32_t c : members) {
+      const auto it = accepted_.nodes_of_host.find(c);
+      if (it == accepted_.nodes_of_host.end()) continue;
+      for (std::size_t k = 0; k < it->second.size(); ++k) {
+        node_id_[{c, k}] = static_cast<std::uint32_t>(tube_.nodes.size());
+        tube_.nodes.push_back(TubeNode{it->second[k].p_Bin});
+      }
+    }
+    for (const std::uint32_t c : members) AddChain(c);
+    return WithoutPassThroughNodes(tube_);
+  }
+
+ private:
+  // The node a chain's free end is linked to, or a new end node.
+  std::uint32_t EndNode(std::uint32_t chain, bool at_end) {
+    for (std::size_t k = 0; k < accepted_.meetings.size(); ++k) {
+      const auto& ends = accepted_.meetings[k].ends;
+      if (std::find(ends.begin(), ends.end(), std::make_pair(chain, at_end)) != ends.end()) {
+        return node_id_.at({kMeeting, k});
+      }
+    }
+    for (std::size_t i = 0; i < accepted_.junctions.size(); ++i) {
+      const Junction& j = accepted_.junctions[i];
+      if (j.branch == chain && j.at_end == at_end)
+        return node_id_.at({j.host, accepted_.node_of_junction[i]});
+    }
+    tube_.nodes.push_back(TubeNode{EndOf(chains_[chain], at_end).p});
+    return static_cast<std::uint32_t>(tube_.nodes.size() - 1);
+  }
+
+  void CloseBranch(std::uint32_t to_node) {
+    const auto count = static_cast<std::uint32_t>(tube_.cylinders.size()) - first_;
+    if (count > 0) tube_.branches.push_back(TubeBranch{from_, to_node, first_, count});
+    from_ = to_node;
+    first_ = static_cast<std::uint32_t>(tube_.cylinders.size());
+  }
+
+  void AddChain(std::uint32_t c) {
+    const Tube& chain = chains_[c];
+    const std::vector<AxisPiece> pieces = TubeAxisPieces(chain);
+    // Cuts: (position on the pieces, node id), ascending.
+    std::vector<std::pair<double, std::uint32_t>> cuts;
+    if (const auto it = accepted_.nodes_of_host.find(c); it != accepted_.nodes_of_host.end()) {
+      for (std::size_t k = 0; k < it->second.size(); ++k)
+        cuts.emplace_back(it->second[k].position, node_id_.at({c, k}));
+    }
+    std::sort(cuts.begin(), cuts.end());
+    from_ = EndNode(c, /*at_end=*/false);
+    first_ = static_cast<std::uint32_t>(tube_.cylinders.size());
+    std::size_t next_cut = 0;
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+      const AxisPiece& piece = pieces[k];
+      if (piece.cylinder < 0) {  // a joint: cuts on it fall between its two cylinders
+        while (next_cut < cuts.size() && cuts[next_cut].first < static_cast<double>(k + 1)) {
+          CloseBranch(cuts[next_cut++].second);
+        }
+        continue;
+      }
+      Cylinder cylinder = chain.cylinders[static_cast<std::size_t>(piece.cylinder)];
+      const double length = cylinder.length();
+      double done = 0.0;  // fraction of this cylinder already emitted
+      while (next_cut < cuts.size() && cuts[next_cut].first < static_cast<double>(k + 1)) {
+        const double t = cuts[next_cut].first - static_cast<double>(k);
+        const std::uint32_t node = cuts[next_cut++].second;
+        if ((t - done) * length < kMinPiece) {  // at the start of what is left: cut before it
+          CloseBranch(node);
+        } else if ((1.0 - t) * length < kMinPiece) {  // at its end: cut after it
+          tube_.cylinders.push_back(cylinder);
+          done = 1.0;
+          CloseBranch(node);
+        } else {
+          const Eigen::Vector3d foot = chain.cylinders[static_cast<std::size_t>(piece.cylinder)].start +
+                                       t * (chain.cylinders[static_cast<std::size_t>(piece.cylinder)].end -
+                                            chain.cylinders[static_cast<std::size_t>(piece.cylinder)].start);
+          Cylinder first = cylinder;
+          first.end = foot;
+          tube_.cylinders.push_back(first);
+          cylinder.start = foot;
+          done = t;
+          CloseBranch(node);
+        }
+      }
+      if (done < 1.0) tube_.cylinders.push_back(cylinder);
+    }
+    CloseBranch(EndNode(c, /*at_end=*/true));
+  }
+
+  // The "host" of a Y-piece's node in node_id_'s keys.
+  static constexpr std::uint32_t kMeeting = ~std::uint32_t{0};
+  const std::vector<Tube>& chains_;
+  const Accepted& accepted_;
+  Tube tube_;
+  std::map<std::pair<std::uint32_t, std::size_t>, std::uint32_t> node_id_;
+  std::uint32_t from_ = 0;
+  std::uint32_t first_ = 0;
+};
+
+// Sorts longest first and numbers the tubes 0..n−1; rank[t] is the new index of tubes[t].
+std::vector<Tube> LongestFirst(std::vector<Tube> tubes, std::vector<std::uint32_t>* rank) {
+  std::vector<double> length(tubes.size());
+  for (std::size_t t = 0; t < tubes.size(); ++t) length[t] = tubes[t].length();
+  std::vector<std::size_t> order(tubes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return length[a] > length[b]; });
+  std::vector<Tube> sorted;
+  sorted.reserve(tubes.size());
+  rank->assign(tubes.size(), 0);
+  for (const std::size_t t : order) {
+    (*rank)[t] = static_cast<std::uint32_t>(sorted.size());
+    sorted.push_back(std::move(tubes[t]));
+    sorted.back().id = static_cast<std::uint32_t>(sorted.size() - 1);
+  }
+  return sorted;
+}
+
+}  // namespace
+
+void JunctionParams::Validate() const {
+  RequireNonNegative(max_gap, "modeling.junctions.max_gap");
+  RequireNonNegative(max_axis_offset, "modeling.junctions.max_axis_offset");
+  RequireNonNegative(side_max_gap, "modeling.junctions.side_max_gap");
+  RequireNonNegative(side_max_axis_offset, "modeling.junctions.side_max_axis_offset");
+  RequireInRange(min_angle, 0.0, kPi / 2.0, "modeling.junctions.min_angle");
+  if (max_branches_per_node < 3) {
+    throw InvalidArgument(
+        "modeling.junctions.max_branches_per_node: " + std::to_string(max_branches_per_node) +
+        " is below 3 (a junction joins at least three branches)");
+  }
+  if (min_meeting_ends < 2 || min_meeting_ends > max_branches_per_node) {
+    throw InvalidArgument(
+        "modeling.junctions.min_meeting_ends: " + std::to_string(min_meeting_ends) +
+        " is out of range [2, max_branches_per_node = " + std::to_string(max_branches_per_node) + "]");
+  }
+  RequireNonNegative(node_spacing, "modeling.junctions.node_spacing");
+  RequireNonNegative(max_tube_length, "modeling.junctions.max_tube_length");
+  RequireNonNegative(chain_max_distance, "modeling.junctions.chain_max_distance");
+  RequireNonNegative(link_max_distance, "modeling.junctions.link_max_distance");
+  RequireInRange(link_max_angle, 0.0, kPi, "modeling.junctions.link_max_angle");
+  RequireInRange(chain_max_angle, 0.0, kPi, "modeling.junctions.chain_max_angle");
+  RequireNonNegative(auto_min_per_tube, "modeling.junctions.auto_min_per_tube");
+}
+
+std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params) {
+  params.Validate();
+  const double cos_min = std::cos(params.min_angle);
+  std::vector<Junction> out;
+  std::vector<std::vector<AxisPiece>> pieces(chains.size());
+  std::vector<double> arc_length(chains.size());
+  for (std::size_t h = 0; h < chains.size(); ++h) {
+    pieces[h] = TubeAxisPieces(chains[h]);
+    arc_length[h] = ArcLength(pieces[h]);
+  }
+  for (std::uint32_t b = 0; b < chains.size(); ++b) {
+    if (chains[b].cylinders.empty() || chains[b].branched()) continue;
+    for (const bool at_end : {false, true}) {
+      const FreeEnd end = EndOf(chains[b], at_end);
+      std::optional<Junction> best_overall;
+      for (std::uint32_t h = 0; h < chains.size(); ++h) {
+        if (h == b || chains[h].branched()) continue;
+        std::optional<Junction> best;
+        for (std::size_t k = 0; k < pieces[h].size(); ++k) {
+          const AxisPiece& piece = pieces[h][k];
+          const Eigen::Vector3d axis = piece.b - piece.a;
+          if (!(axis.norm() > 0.0)) continue;
+          if (std::abs(end.out.dot(axis.normalized())) > cos_min) continue;
+          const double reach = piece.radius + params.side_max_gap;
+          const SegmentClosestPoints cp =
+              ClosestPointsOfSegments(end.p, end.p + reach * end.out, piece.a, piece.b);
+          if (cp.distance > params.side_max_axis_offset) continue;
+          const double position = static_cast<double>(k) + cp.t;
+          const double arc = ArcAt(pieces[h], position);
+          if (arc < params.node_spacing || arc_length[h] - arc < params.node_spacing) continue;
+          Junction j{b, at_end, h, position, piece.a + cp.t * axis, cp.s * reach, cp.distance};
+          if (!best || j.reach + j.offset < best->reach + best->offset) best = j;
+        }
+        if (best) out.push_back(*best);
+      }
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Junction& x, const Junction& y) {
+    return std::make_tuple(x.reach + x.offset, x.branch, x.at_end, x.host) <
+           std::make_tuple(y.reach + y.offset, y.branch, y.at_end, y.host);
+  });
+  return out;
+}
+
+JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
+                              const StopToken* stop) {
+  params.Validate();
+  ThrowIfStopped(stop, "joining");
+  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params), params),
+                                   FindJunctions(chains, params), params, stop);
+  JunctionJoining out;
+  out.y_pieces =
+      static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
+                                               [](const MeetingNode& n) { return n.ends.size() >= 3; }));
+  out.junctions = static_cast<std::uint32_t>(accepted.junctions.size()) + out.y_pieces;
+
+  // Components (by the smallest chain index in them), in order of that index.
+  std::vector<std::uint32_t> component(chains.size());
+  std::iota(component.begin(), component.end(), 0);
+  bool changed = true;
+  while (changed) {  // a handful of junctions: simple relaxation is enough
+    changed = false;
+    auto link = [&](std::uint32_t a, std::uint32_t b) {
+      const std::uint32_t m = std::min(component[a], component[b]);
+      if (component[a] != m || component[b] != m) {
+        component[a] = component[b] = m;
+        changed = true;
+      }
+    };
+    for (const Junction& j : accepted.junctions) link(j.branch, j.host);
+    for (const MeetingNode& n : accepted.meetings) {
+      for (const auto& end : n.ends) link(n.ends.front().first, end.first);
+    }
+  }
+  std::map<std::uint32_t, std::vector<std::uint32_t>> members;
+  for (std::uint32_t c = 0; c < chains.size(); ++c) members[component[c]].push_back(c);
+  std::vector<Tube> tubes;
+  std::vector<std::uint32_t> built_from(chains.size());
+  TreeBuilder builder(chains, accepted);
+  for (const auto& [root, list] : members) {
+    for (const std::uint32_t c : list) built_from[c] = static_cast<std::uint32_t>(tubes.size());
+    if (list.size() > 1) out.chains_in_junctions += static_cast<std::uint32_t>(list.size());
+    tubes.push_back(list.size() == 1 ? chains[list.front()] : builder.Build(list));
+  }
+  std::vector<std::uint32_t> rank;
+  out.tubes = LongestFirst(std::move(tubes), &rank);
+  out.tube_of_chain.resize(chains.size());
+  for (std::size_t c = 0; c < chains.size(); ++c) out.tube_of_chain[c] = rank[built_from[c]];
+  return out;
+}
+
+bool LooksBranched(const JunctionJoining& joined, const JunctionParams& params) {
+  return joined.y_pieces >= params.auto_min_y_pieces ||
+         (joined.junctions >= params.auto_min_junctions &&
+          static_cast<double>(joined.junctions) >=
+              params.auto_min_per_tube * static_cast<double>(joined.tubes.size()));
+}
+
+}  // namespace tubepick

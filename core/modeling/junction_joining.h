@@ -1,0 +1,113 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/cell_config.h"
+#include "core/common/stop_token.h"
+#include "core/common/types.h"
+
+namespace tubepick {
+
+/// Junction joining: where free ends of chains meet each other (a Y-piece: every branch ends at
+/// the node) or another chain's side (a T-piece: the run goes on through the node).
+struct JunctionParams {
+  /// Y-pieces: how far each free end's axis is extended to meet the others: its radius plus this,
+  /// metres.
+  double max_gap = 0.04;
+  /// Y-pieces: largest distance between two extended axes where they meet, metres.
+  double max_axis_offset = 0.016;
+  /// T-pieces: longest gap from a chain's free end, along its axis, to the surface of the tube
+  /// it meets, metres (the other tube's radius is added to reach its axis).
+  double side_max_gap = 0.04;
+  /// T-pieces: largest distance between the end's extended axis and the other tube's axis, metres:
+  /// a branch points at the axis it leaves; a tube lying across another does not (its axis
+  /// passes two radii above).
+  double side_max_axis_offset = 0.016;
+  /// Smallest angle between the branch's axis and the other tube's axis, radians: nearly
+  /// parallel ends are the linear joining's business.
+  double min_angle = 25.0 * 3.14159265358979323846 / 180.0;
+  /// Fewest free ends meeting at one point that make a node there (a Y-piece has 3; 2 also
+  /// accepts a Y-piece whose third branch is hidden, as a kinked link).
+  std::uint32_t min_meeting_ends = 3;
+  /// Most branches meeting at one node (3 = T- and Y-pieces only).
+  std::uint32_t max_branches_per_node = 4;
+  /// A junction closer than this to the other chain's free end is not one (that would be an end
+  /// to end join), and junctions closer than this on one chain become one node, metres.
+  double node_spacing = 0.02;
+  /// Where junctions are looked for, the linear joining before them is held to these limits
+  /// (modeling.joining's own when smaller): joining arms end to end across a Y-piece (a 60°
+  /// kink) or across a junction blob would take the ends the junction needs. Metres, radians.
+  double chain_max_distance = 0.06;
+  double chain_max_angle = 1.0;
+  /// Two free ends that meet with no third end (kinked past chain_max_angle, or across a gap the
+  /// linear joining found visible: at a junction the gap holds the junction's own surface) are
+  /// linked end to end, after the junctions, within these limits (α + β as the linear joining).
+  double link_max_distance = 0.06;
+  double link_max_angle = 3.14159265358979323846 / 2.0;
+  /// Longest tube (cylinders, joints and junction links) joining may build, metres; 0 = no limit.
+  double max_tube_length = 0.80;
+  /// `auto` topology: a scene counts as branched when at least this many junctions are found ...
+  std::uint32_t auto_min_junctions = 3;
+  /// ... and at least this many per tube they leave: a bin of linear tubes shows a few chance
+  /// junctions (0–0.33 per tube on generated 10-tube bins of sets A and B), a bin of set C tubes
+  /// (two junctions each) 0.5–1.1 (docs/ACCURACY.md).
+  double auto_min_per_tube = 0.45;
+  /// ... or when at least this many of the junctions are Y-pieces (three free ends meeting at a
+  /// point: 0–2 in those linear bins, 2–12 in the branched ones, 4–6 with 20 tubes).
+  std::uint32_t auto_min_y_pieces = 3;
+
+  /// @throws InvalidArgument naming "modeling.junctions.<key>" and the value.
+  void Validate() const;
+};
+
+/// One junction found: chain `branch`'s free end (`at_end`: its last cylinder's end, else its
+/// first cylinder's start) meets chain `host`'s axis at `p_Bin`.
+struct Junction {
+  std::uint32_t branch = 0;
+  bool at_end = false;
+  std::uint32_t host = 0;
+  /// Position along the host chain's axis pieces (TubeAxisPieces): piece index + fraction.
+  double host_position = 0.0;
+  Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
+  /// Distance along the branch's axis from its end to p_Bin, metres.
+  double reach = 0.0;
+  /// Distance between the extended branch axis and the host axis, metres.
+  double offset = 0.0;
+};
+
+/// Candidate junctions of linear `chains` (JoinTubes' output), cheapest first (reach + offset),
+/// each within the limits of `params` on its own.
+std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params);
+
+/// What junction joining made of a scene's chains.
+struct JunctionJoining {
+  /// Tube ids 0..n−1, longest tube first.
+  std::vector<Tube> tubes;
+  /// Per input chain: the index of the output tube that holds it.
+  std::vector<std::uint32_t> tube_of_chain;
+  /// Junctions accepted (Y-pieces and T-pieces).
+  std::uint32_t junctions = 0;
+  /// Of them, Y-pieces (three or more free ends meeting).
+  std::uint32_t y_pieces = 0;
+  /// Chains that take part in a junction.
+  std::uint32_t chains_in_junctions = 0;
+};
+
+/// Joins linear chains (JoinTubes' output) into trees: nodes where three or more free ends meet
+/// (Y-pieces, ClusterMeetings) first, then free ends meeting another chain's side (T-pieces),
+/// cheapest first, while each keeps every tube a tree (no cycle), uses each free end once, gives
+/// no node more than max_branches_per_node branches and keeps the tube within max_tube_length.
+/// A host chain is cut at each T-junction on it (the cylinder under it is split at the
+/// junction's foot); every branch end is linked to its node by a joint (TubeJoints). Tubes
+/// without a junction are returned as they came (linear, implicit graph). Deterministic.
+/// @throws InvalidArgument for invalid parameters. @throws Cancelled when `stop` fires.
+JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
+                              const StopToken* stop = nullptr);
+
+/// Topology `auto`: whether a scene shows branched tubes (at least auto_min_junctions junctions
+/// and auto_min_per_tube per tube joining left, or at least auto_min_y_pieces Y-pieces).
+bool LooksBranched(const JunctionJoining& joined, const JunctionParams& params);
+
+}  // namespace tubepick

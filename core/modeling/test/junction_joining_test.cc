@@ -1,0 +1,163 @@
+#include "core/modeling/junction_joining.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/common/errors.h"
+#include "core/common/tube_graph.h"
+
+namespace tubepick {
+namespace {
+
+using ::testing::HasSubstr;
+constexpr double kR = 0.0125;
+constexpr double kPi = 3.14159265358979323846;
+
+Cylinder Cyl(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::uint32_t segment) {
+  Cylinder c;
+  c.start = a;
+  c.end = b;
+  c.radius = kR;
+  c.segment_id = segment;
+  return c;
+}
+
+Tube Chain(std::vector<Cylinder> cylinders) {
+  Tube t;
+  t.cylinders = std::move(cylinders);
+  return t;
+}
+
+Eigen::Vector3d Dir(double degrees) {
+  return Eigen::Vector3d(std::cos(degrees * kPi / 180.0), std::sin(degrees * kPi / 180.0), 0.0);
+}
+
+// Three arms of a Y-piece at `node`, 120° apart, each starting `gap` from the node (region
+// growing leaves the junction blob out), lengths 0.30, 0.10, 0.10 as set C's first node.
+std::vector<Tube> YPiece(const Eigen::Vector3d& node, double gap, std::uint32_t first_segment) {
+  std::vector<Tube> arms;
+  const double lengths[3] = {0.30, 0.10, 0.10};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d d = Dir(90.0 + 120.0 * k);
+    arms.push_back(Chain({Cyl(node + gap * d, node + (gap + lengths[k]) * d, first_segment + k)}));
+  }
+  return arms;
+}
+
+TEST(JunctionJoining, ThreeArmsMeetingAtAPointBecomeOneTreeWithAYNode) {
+  const Eigen::Vector3d node(0.05, -0.02, kR);
+  const JunctionJoining joined = JoinJunctions(YPiece(node, 0.025, 0), JunctionParams{});
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  EXPECT_EQ(joined.junctions, 1u);
+  EXPECT_EQ(joined.y_pieces, 1u);
+  const Tube& t = joined.tubes[0];
+  EXPECT_NO_THROW(ValidateTubeGraph(t, "tube"));
+  ASSERT_EQ(t.branches.size(), 3u);
+  const std::vector<std::uint32_t> degree = NodeDegrees(t);
+  ASSERT_EQ(std::count(degree.begin(), degree.end(), 3u), 1);
+  EXPECT_EQ(std::count(degree.begin(), degree.end(), 1u), 3);
+  const std::size_t junction = std::find(degree.begin(), degree.end(), 3u) - degree.begin();
+  EXPECT_LT((t.nodes[junction].p_Bin - node).norm(), 1e-9);  // the arms' axes cross exactly there
+  EXPECT_NEAR(t.length(), 0.50 + 3 * 0.025, 1e-9);
+  EXPECT_EQ(joined.tube_of_chain, (std::vector<std::uint32_t>{0, 0, 0}));
+}
+
+TEST(JunctionJoining, AnEndPointingAtAnotherTubesSideSplitsItIntoATee) {
+  // A run along x, cylinders of 0.10 and 0.20; a branch along y ending 3 cm from its axis at x = 0.16.
+  std::vector<Tube> chains = {
+      Chain({Cyl({0, 0, kR}, {0.10, 0, kR}, 0), Cyl({0.10, 0, kR}, {0.30, 0, kR}, 1)}),
+      Chain({Cyl({0.16, 0.13, kR}, {0.16, 0.03, kR}, 2)})};
+  const JunctionJoining joined = JoinJunctions(chains, JunctionParams{});
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  EXPECT_EQ(joined.y_pieces, 0u);
+  const Tube& t = joined.tubes[0];
+  EXPECT_NO_THROW(ValidateTubeGraph(t, "tube"));
+  ASSERT_EQ(t.cylinders.size(), 4u);  // the 0.20 cylinder is cut at the junction's foot
+  ASSERT_EQ(t.branches.size(), 3u);
+  const std::vector<std::uint32_t> degree = NodeDegrees(t);
+  const std::size_t junction = std::find(degree.begin(), degree.end(), 3u) - degree.begin();
+  ASSERT_LT(junction, degree.size());
+  EXPECT_TRUE(t.nodes[junction].p_Bin.isApprox(Eigen::Vector3d(0.16, 0, kR), 1e-9));
+  // The cut keeps the run's axis and segment: pieces of 0.06 and 0.14.
+  std::vector<double> lengths;
+  for (const Cylinder& c : t.cylinders) lengths.push_back(c.length());
+  std::sort(lengths.begin(), lengths.end());
+  EXPECT_NEAR(lengths[0], 0.06, 1e-9);
+  EXPECT_NEAR(lengths[3], 0.14, 1e-9);
+  EXPECT_NEAR(t.length(), 0.30 + 0.03 + 0.10, 1e-9);
+}
+
+TEST(JunctionJoining, ATubeLyingAcrossAnotherIsNoJunction) {
+  // The second tube's end is 3 cm from the first's side but its axis passes two radii above.
+  std::vector<Tube> chains = {Chain({Cyl({0, 0, kR}, {0.30, 0, kR}, 0)}),
+                              Chain({Cyl({0.16, 0.13, 3 * kR}, {0.16, 0.03, 3 * kR}, 1)})};
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}).tubes.size(), 2u);
+  // And an end that points along the other tube (15° off it) is the linear joining's business.
+  chains[1] = Chain({Cyl(Eigen::Vector3d(0.16, 0, kR) + 0.13 * Dir(165),
+                         Eigen::Vector3d(0.16, 0, kR) + 0.03 * Dir(165), 1)});
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}).tubes.size(), 2u);
+}
+
+TEST(JunctionJoining, LimitsKeepTreesAndSizes) {
+  // Two Y-pieces sharing the long arm would close no cycle; but the tube would be 1.1 m.
+  std::vector<Tube> chains = YPiece({0, 0, kR}, 0.025, 0);
+  JunctionParams params;
+  params.max_tube_length = 0.5;  // the Y is 0.575 m with its links
+  EXPECT_EQ(JoinJunctions(chains, params).tubes.size(), 3u);
+  params = JunctionParams{};
+  chains.pop_back();  // two ends meeting alone (a 60° kink) are linked end to end: one linear tube
+  const JunctionJoining linked = JoinJunctions(chains, params);
+  ASSERT_EQ(linked.tubes.size(), 1u);
+  EXPECT_FALSE(linked.tubes[0].branched());
+  EXPECT_EQ(BranchesOf(linked.tubes[0]).size(), 1u);  // no pass-through node is left
+  EXPECT_NEAR(linked.tubes[0].length(), 0.40 + 2 * 0.025 * std::sin(kPi / 3.0), 1e-9);
+  params.link_max_angle = 0.5;  // the kink is 60°: beyond this limit nothing joins them
+  EXPECT_EQ(JoinJunctions(chains, params).tubes.size(), 2u);
+  params.max_branches_per_node = 2;
+  EXPECT_THAT(
+      [&] { JoinJunctions(chains, params); },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_branches_per_node: 2")));
+}
+
+TEST(JunctionJoining, AutoTopologyNeedsSeveralJunctionsOrYPieces) {
+  JunctionParams params;
+  JunctionJoining joined;
+  joined.tubes.resize(10);
+  joined.junctions = 2;
+  EXPECT_FALSE(LooksBranched(joined, params));  // below auto_min_junctions
+  joined.junctions = 4;
+  EXPECT_FALSE(LooksBranched(joined, params));  // 0.4 per tube
+  joined.junctions = 5;
+  EXPECT_TRUE(LooksBranched(joined, params));
+  joined.junctions = 3;
+  joined.y_pieces = 3;
+  EXPECT_TRUE(LooksBranched(joined, params));
+}
+
+TEST(JunctionJoining, IsDeterministicAndKeepsLinearChainsAsTheyCame) {
+  std::vector<Tube> chains = YPiece({0, 0, kR}, 0.02, 0);
+  const std::vector<Tube> y2 = YPiece({0.4, 0.1, kR}, 0.03, 10);
+  chains.insert(chains.end(), y2.begin(), y2.end());
+  chains.push_back(Chain({Cyl({-0.3, -0.25, kR}, {0.1, -0.25, kR}, 20)}));
+  const JunctionJoining a = JoinJunctions(chains, JunctionParams{});
+  const JunctionJoining b = JoinJunctions(chains, JunctionParams{});
+  ASSERT_EQ(a.tubes.size(), 3u);
+  ASSERT_EQ(b.tubes.size(), 3u);
+  for (std::size_t t = 0; t < a.tubes.size(); ++t) {
+    EXPECT_EQ(a.tubes[t].id, t);
+    EXPECT_EQ(a.tubes[t].branches, b.tubes[t].branches);
+    EXPECT_EQ(a.tubes[t].cylinders.size(), b.tubes[t].cylinders.size());
+  }
+  // The lone straight tube (0.40 m) is returned as it came: implicit graph, same cylinder.
+  const auto lone = std::find_if(a.tubes.begin(), a.tubes.end(), [](const Tube& t) { return !t.branched(); });
+  ASSERT_NE(lone, a.tubes.end());
+  EXPECT_TRUE(lone->branches.empty());
+  EXPECT_EQ(lone->cylinders[0].segment_id, 20u);
+  EXPECT_EQ(a.tube_of_chain[6], static_cast<std::uint32_t>(lone - a.tubes.begin()));
+}
+
+}  // namespace
+}  // namespace tubepick
