@@ -15,7 +15,7 @@ namespace tubepick {
 struct JunctionParams {
   /// Y-pieces: how far each free end's axis is extended to meet the others: its radius plus this,
   /// metres.
-  double max_gap = 0.04;
+  double max_gap = 0.05;
   /// Y-pieces: largest distance between two extended axes where they meet, metres.
   double max_axis_offset = 0.016;
   /// T-pieces: longest gap from a chain's free end, along its axis, to the surface of the tube
@@ -44,16 +44,17 @@ struct JunctionParams {
   /// Two free ends that meet with no third end (kinked past chain_max_angle, or across a gap the
   /// linear joining found visible: at a junction the gap holds the junction's own surface) are
   /// linked end to end, after the junctions, within these limits (α + β as the linear joining).
-  double link_max_distance = 0.06;
+  double link_max_distance = 0.08;
   double link_max_angle = 3.14159265358979323846 / 2.0;
   /// Longest tube (cylinders, joints and junction links) joining may build, metres; 0 = no limit.
   double max_tube_length = 0.80;
   /// `auto` topology: a scene counts as branched when at least this many junctions are found ...
   std::uint32_t auto_min_junctions = 3;
   /// ... and at least this many per tube they leave: a bin of linear tubes shows a few chance
-  /// junctions (0–0.33 per tube on generated 10-tube bins of sets A and B), a bin of set C tubes
-  /// (two junctions each) 0.5–1.1 (docs/ACCURACY.md).
-  double auto_min_per_tube = 0.45;
+  /// junctions (about 0–0.35 per tube on generated 10-tube bins of sets A and B, more in dense
+  /// 20-tube bins of set B, where 0.45 took bins for branched), a bin of set C tubes (two junctions
+  /// each) 0.5–1.1 (docs/ACCURACY.md).
+  double auto_min_per_tube = 0.7;
   /// ... or when at least this many of the junctions are Y-pieces (three free ends meeting at a
   /// point: 0–2 in those linear bins, 2–12 in the branched ones, 4–6 with 20 tubes).
   std::uint32_t auto_min_y_pieces = 3;

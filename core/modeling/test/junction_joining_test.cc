@@ -128,9 +128,9 @@ TEST(JunctionJoining, AutoTopologyNeedsSeveralJunctionsOrYPieces) {
   joined.tubes.resize(10);
   joined.junctions = 2;
   EXPECT_FALSE(LooksBranched(joined, params));  // below auto_min_junctions
-  joined.junctions = 4;
-  EXPECT_FALSE(LooksBranched(joined, params));  // 0.4 per tube
-  joined.junctions = 5;
+  joined.junctions = 6;
+  EXPECT_FALSE(LooksBranched(joined, params));  // 0.6 per tube
+  joined.junctions = 7;
   EXPECT_TRUE(LooksBranched(joined, params));
   joined.junctions = 3;
   joined.y_pieces = 3;
