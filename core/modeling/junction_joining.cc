@@ -34,6 +34,7 @@
 #include "core/common/require.h"
 #include "core/common/segment_geometry.h"
 #include "core/common/tube_graph.h"
+#include "core/modeling/tube_joining.h"
 
 namespace tubepick {
 namespace {
@@ -107,7 +108,6 @@ struct MeetingNode {
   std::vector<std::pair<std::uint32_t, bool>> ends;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int points = 0;
-  double cost = 0.0;
   bool linkable = false;
 
   Eigen::Vector3d Centre() const { return sum / points; }
@@ -134,14 +134,12 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
     }
   }
   std::vector<EndMeeting> out;
+  // As the linear joining measures a pair (α + β, no angle below the mean radius: touching ends).
   auto linkable = [&](const End& x, const End& y) {
-    const Eigen::Vector3d d = y.end.p - x.end.p;
-    const double distance = d.norm();
-    if (distance > params.link_max_distance) return false;
-    if (distance < 0.5 * (x.reach + y.reach - 2.0 * params.max_gap)) return true;  // touching: any angle
-    const double a = std::atan2(x.end.out.cross(d).norm(), x.end.out.dot(d));
-    const double b = std::atan2(y.end.out.cross(-d).norm(), y.end.out.dot(-d));
-    return a + b <= params.link_max_angle;
+    const double mean_radius = 0.5 * (x.reach + y.reach) - params.max_gap;
+    const JoinDistance d =
+        EndpointDistance(x.end.p, x.end.out, y.end.p, y.end.out, mean_radius, JoiningParams{});
+    return d.euclidean <= params.link_max_distance && d.angular <= params.link_max_angle;
   };
   for (std::size_t i = 0; i < ends.size(); ++i) {
     for (std::size_t k = i + 1; k < ends.size(); ++k) {
@@ -214,7 +212,7 @@ std::vector<MeetingNode> ClusterMeetings(const std::vector<EndMeeting>& meetings
   for (const EndMeeting& m : meetings) {
     const auto a = node_of_end.find(m.a), b = node_of_end.find(m.b);
     if (a == node_of_end.end() && b == node_of_end.end()) {
-      nodes.push_back(MeetingNode{{m.a, m.b}, m.p, 1, m.cost, m.linkable});
+      nodes.push_back(MeetingNode{{m.a, m.b}, m.p, 1, m.linkable});
       node_of_end[m.a] = node_of_end[m.b] = nodes.size() - 1;
     } else if (b == node_of_end.end()) {
       join(a->second, m.b, m.p);
@@ -269,8 +267,7 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
         forest.Length(j.branch) + forest.Length(j.host) + link > params.max_tube_length) {
       continue;
     }
-    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains[j.host]);
-    const double arc = ArcAt(pieces, j.host_position);
+    const double arc = j.host_arc;
     std::vector<HostNode>& nodes = out.nodes_of_host[j.host];
     auto near = std::find_if(nodes.begin(), nodes.end(),
                              [&](const HostNode& n) { return std::abs(n.arc - arc) < params.node_spacing; });
@@ -482,7 +479,7 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
           const double position = static_cast<double>(k) + cp.t;
           const double arc = ArcAt(pieces[h], position);
           if (arc < params.node_spacing || arc_length[h] - arc < params.node_spacing) continue;
-          Junction j{b, at_end, h, position, piece.a + cp.t * axis, cp.s * reach, cp.distance};
+          Junction j{b, at_end, h, position, arc, piece.a + cp.t * axis, cp.s * reach, cp.distance};
           if (!best || j.reach + j.offset < best->reach + best->offset) best = j;
         }
         if (best) out.push_back(*best);

@@ -71,6 +71,8 @@ struct Junction {
   std::uint32_t host = 0;
   /// Position along the host chain's axis pieces (TubeAxisPieces): piece index + fraction.
   double host_position = 0.0;
+  /// The same as arc length along the host's axis from its first end, metres.
+  double host_arc = 0.0;
   Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
   /// Distance along the branch's axis from its end to p_Bin, metres.
   double reach = 0.0;

@@ -135,19 +135,14 @@ TEST(Classification, RejectsNegativeTolerance) {
 namespace tubepick {
 namespace {
 
+using testing_planning::MakeCylinder;
+
 // A tee: a run along x cut at x = 0.10, and a branch along y starting `link` from the node.
 Tube Tee(double link) {
   Tube t;
-  auto cyl = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::uint32_t segment) {
-    Cylinder c;
-    c.start = a;
-    c.end = b;
-    c.radius = 0.0125;
-    c.segment_id = segment;
-    return c;
-  };
-  t.cylinders = {cyl({0, 0, 0.0125}, {0.10, 0, 0.0125}, 0), cyl({0.10, 0, 0.0125}, {0.20, 0, 0.0125}, 0),
-                 cyl({0.10, link, 0.0125}, {0.10, link + 0.10, 0.0125}, 1)};
+  t.cylinders = {MakeCylinder({0, 0, 0.0125}, {0.10, 0, 0.0125}, 0),
+                 MakeCylinder({0.10, 0, 0.0125}, {0.20, 0, 0.0125}, 0),
+                 MakeCylinder({0.10, link, 0.0125}, {0.10, link + 0.10, 0.0125}, 1)};
   t.nodes = {TubeNode{{0, 0, 0.0125}}, TubeNode{{0.10, 0, 0.0125}}, TubeNode{{0.20, 0, 0.0125}},
              TubeNode{{0.10, link + 0.10, 0.0125}}};
   t.branches = {TubeBranch{0, 1, 0, 1}, TubeBranch{1, 2, 1, 1}, TubeBranch{1, 3, 2, 1}};
