@@ -48,6 +48,19 @@ TEST(CellConfig, RejectsUnknownKeyNamingIt) {
   }
 }
 
+TEST(CellConfig, ReadsTheTopologyAndRejectsAnUnknownOneNamingIt) {
+  EXPECT_EQ(ParseCellConfig("{}").tube.topology, TubeTopology::kLinear);
+  EXPECT_EQ(ParseCellConfig("tube:\n  topology: branched\n").tube.topology, TubeTopology::kBranched);
+  EXPECT_EQ(ParseCellConfig("tube:\n  topology: auto\n").tube.topology, TubeTopology::kAuto);
+  try {
+    ParseCellConfig("tube:\n  topology: tree\n");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("tube.topology"));
+    EXPECT_THAT(e.what(), HasSubstr("'tree'"));
+  }
+}
+
 TEST(CellConfig, RejectsOutOfRangeRadius) {
   try {
     ParseCellConfig("tube:\n  radius: -0.01\n");
