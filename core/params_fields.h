@@ -240,6 +240,13 @@ void DescribeFields(Visit& v, CostParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, CertaintyParams& p) {
+  v("safe_first", p.safe_first);
+  v("safe_displacement", p.safe_displacement);
+  v("contact_margin", p.contact_margin);
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, PlanningParams& p) {
   v.Section("classification", p.classification);
   v.Section("trajectories", p.trajectories);
@@ -247,6 +254,7 @@ void DescribeFields(Visit& v, PlanningParams& p) {
   v.Section("filters", p.filters);
   v.Section("tool", p.tool);
   v.Section("cost", p.cost);
+  v.Section("certainty", p.certainty);
   v("empty_max_points", p.empty_max_points);
   v("empty_min_height", p.empty_min_height);
   v("strongly_occluded_candidates", p.strongly_occluded_candidates);

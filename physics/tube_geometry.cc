@@ -105,7 +105,65 @@ std::vector<Eigen::Vector3d> TubeGeometry::Centreline() const {
   return line;
 }
 
+namespace {
+
+// A tree's edges as a core Tube graph: a node for every end and junction (degree ≠ 2), a branch
+// for every chain of edges between two of them.
+Tube TreeToTube(const TubeGeometry& g) {
+  std::map<int, std::vector<std::size_t>> incident;
+  for (std::size_t e = 0; e < g.edges.size(); ++e) {
+    incident[g.edges[e].node1].push_back(e);
+    incident[g.edges[e].node2].push_back(e);
+  }
+  if (g.edges.empty() || incident.size() != g.edges.size() + 1) {
+    throw InvalidArgument("tube " + std::to_string(g.id) + " is not a tree (" +
+                          std::to_string(g.edges.size()) + " edges on " + std::to_string(incident.size()) +
+                          " nodes)");
+  }
+  Tube tube;
+  tube.id = static_cast<std::uint32_t>(g.id);
+  std::map<int, std::uint32_t> node_index;
+  for (const auto& [node_id, edges] : incident) {
+    if (edges.size() == 2) continue;
+    node_index[node_id] = static_cast<std::uint32_t>(tube.nodes.size());
+    tube.nodes.push_back(tubepick::TubeNode{g.Node(node_id).centre});
+  }
+  std::vector<bool> used(g.edges.size(), false);
+  for (const auto& [from, index] : node_index) {
+    for (std::size_t first : incident.at(from)) {
+      if (used[first]) continue;
+      TubeBranch branch;
+      branch.from_node = index;
+      branch.first_cylinder = static_cast<std::uint32_t>(tube.cylinders.size());
+      int at = from;
+      for (std::size_t e = first;;) {
+        used[e] = true;
+        const int next = g.edges[e].node1 == at ? g.edges[e].node2 : g.edges[e].node1;
+        Cylinder c;
+        c.start = g.Node(at).centre;
+        c.end = g.Node(next).centre;
+        c.radius = g.edges[e].radius;
+        c.segment_id = static_cast<std::uint32_t>(e);
+        tube.cylinders.push_back(c);
+        at = next;
+        const std::vector<std::size_t>& around = incident.at(at);
+        if (around.size() != 2) break;
+        e = around[0] == e ? around[1] : around[0];
+      }
+      branch.to_node = node_index.at(at);
+      branch.cylinder_count = static_cast<std::uint32_t>(tube.cylinders.size()) - branch.first_cylinder;
+      tube.branches.push_back(branch);
+    }
+  }
+  if (std::find(used.begin(), used.end(), false) != used.end())
+    throw InvalidArgument("tube " + std::to_string(g.id) + " is not connected");
+  return tube;
+}
+
+}  // namespace
+
 Tube TubeGeometry::ToTube() const {
+  if (!IsLinear()) return TreeToTube(*this);
   const std::vector<Eigen::Vector3d> line = Centreline();
   const double radius = edges.front().radius;
   Tube tube;

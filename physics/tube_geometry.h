@@ -66,8 +66,10 @@ struct TubeGeometry {
   /// edge has the lowest `order` (ties: the lower node id), so generated and read tubes run
   /// node1 → node2 of the first chain. @throws InvalidArgument when the tube is not linear.
   std::vector<Eigen::Vector3d> Centreline() const;
-  /// The tube as a core Tube (cylinders ordered along the centreline, joints of zero length).
-  /// @throws InvalidArgument when the tube is not linear.
+  /// The tube as a core Tube: a linear tube's cylinders ordered along the centreline (joints of
+  /// zero length, no explicit graph); a tree's with its graph (a node per end and junction, a
+  /// branch per chain of edges between them; segment_id is the edge index).
+  /// @throws InvalidArgument when the tube is neither (a cycle, or not connected).
   Tube ToTube() const;
 
   /// This geometry moved rigidly by X_NewOld (nodes, edge centres and orientations).

@@ -38,6 +38,9 @@ struct TubeClass {
   /// Shorter than the minimum length: an incomplete model, never a pick candidate (it still
   /// takes part in simulations as an obstacle).
   bool too_short = false;
+  /// Non-occluded tubes only, filled by PlanPick: the tubes (indices into the tube list) that lie
+  /// on this one (TubesLyingOn). Its plans are then not sure (PlanCertainty::kUnsure).
+  std::vector<std::uint32_t> lying_on;
 };
 
 /// Occluded joints of `tube` (Def. 5.2.1): joints whose two cylinders come from different

@@ -67,16 +67,31 @@ PlanCosts PlanCost(const Grasp& grasp, const Tube& tube, double max_z, std::opti
                   TrajectoryCost(displacement, params.max_displacement), params);
 }
 
-bool PlanBefore(const PickPlan& a, const PickPlan& b) {
-  return std::forward_as_tuple(a.costs.total, a.tube_id, a.trajectory_index, a.grasp.curve_position,
+bool PlanIsSafe(const PickPlan& plan, const CertaintyParams& params) {
+  switch (plan.certainty) {
+    case PlanCertainty::kSure:
+      return true;
+    case PlanCertainty::kSimulated:
+      return plan.displacement && *plan.displacement <= params.safe_displacement;
+    case PlanCertainty::kUnsure:
+      return false;
+  }
+  return false;
+}
+
+bool PlanBefore(const PickPlan& a, const PickPlan& b, const CertaintyParams& params) {
+  const bool a_unsafe = params.safe_first && !PlanIsSafe(a, params);
+  const bool b_unsafe = params.safe_first && !PlanIsSafe(b, params);
+  return std::forward_as_tuple(a_unsafe, a.costs.total, a.tube_id, a.trajectory_index, a.grasp.curve_position,
                                a.grasp.cylinder_index) <
-         std::forward_as_tuple(b.costs.total, b.tube_id, b.trajectory_index, b.grasp.curve_position,
+         std::forward_as_tuple(b_unsafe, b.costs.total, b.tube_id, b.trajectory_index, b.grasp.curve_position,
                                b.grasp.cylinder_index);
 }
 
-void RankPlans(std::vector<PickPlan>* plans) {
+void RankPlans(std::vector<PickPlan>* plans, const CertaintyParams& params) {
   assert(plans != nullptr);
-  std::stable_sort(plans->begin(), plans->end(), PlanBefore);
+  std::stable_sort(plans->begin(), plans->end(),
+                   [&params](const PickPlan& a, const PickPlan& b) { return PlanBefore(a, b, params); });
 }
 
 }  // namespace tubepick

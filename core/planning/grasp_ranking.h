@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "core/planning/grasp_synthesis.h"
+#include "core/planning/plan_certainty.h"
 #include "core/planning/trajectory.h"
 
 namespace tubepick {
@@ -49,6 +50,8 @@ struct PickPlan {
   /// `disp` measured by the simulation, metres; nullopt when the trajectory was not simulated
   /// (non-occluded tubes, or no evaluator).
   std::optional<double> displacement;
+  /// How sure the plan is to lift its tube alone (PlanCertainty); set by PlanPick.
+  PlanCertainty certainty = PlanCertainty::kSure;
   /// X_BinTcp when placing the tube; attached after planning by core/placement (§5.2.7).
   std::optional<Eigen::Isometry3d> X_BinTcp_place;
 };
@@ -82,11 +85,15 @@ PlanCosts PlanCost(double grasp_z, double max_z, double curve_position, double t
 PlanCosts PlanCost(const Grasp& grasp, const Tube& tube, double max_z, std::optional<double> displacement,
                    const CostParams& params);
 
-/// Strict weak order, best first: lower total cost, then lower tube id, then lower trajectory
-/// index, then lower curve position, then lower cylinder index.
-bool PlanBefore(const PickPlan& a, const PickPlan& b);
+/// The plan is sure, or simulated with a displacement of at most params.safe_displacement.
+bool PlanIsSafe(const PickPlan& plan, const CertaintyParams& params);
+
+/// Strict weak order, best first: with params.safe_first a safe plan (PlanIsSafe) before one that
+/// is not; then lower total cost, then lower tube id, then lower trajectory index, then lower curve
+/// position, then lower cylinder index.
+bool PlanBefore(const PickPlan& a, const PickPlan& b, const CertaintyParams& params);
 
 /// Sorts best first with PlanBefore (deterministic for equal costs).
-void RankPlans(std::vector<PickPlan>* plans);
+void RankPlans(std::vector<PickPlan>* plans, const CertaintyParams& params);
 
 }  // namespace tubepick

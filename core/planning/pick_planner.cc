@@ -65,6 +65,178 @@ class StageTimer {
   std::vector<StageTiming>* timings_;
 };
 
+// What the stages of one PlanPick call share.
+struct PlanningContext {
+  PlanningContext(const ModelingResult& m, const CellConfig& c, const PlanningParams& p,
+                  TrajectoryEvaluator* e, std::uint64_t s, const StopToken* st)
+      : modeling(m), cell(c), params(p), evaluator(e), seed(s), stop(st) {}
+
+  const ModelingResult& modeling;
+  const CellConfig& cell;
+  const PlanningParams& params;
+  TrajectoryEvaluator* evaluator;
+  std::uint64_t seed;
+  const StopToken* stop;
+  double max_z = 0.0;
+  SafetyZone zone;
+  std::unique_ptr<RawCloudIndex> raw;  // built on first use
+  std::vector<TubeGrasps> tube_grasps;
+  // Trajectories of the stages before, so that trajectory indices stay unique in one answer.
+  std::uint32_t trajectories_before = 0;
+};
+
+// Trajectories of the stage's candidate tubes (thesis §5.2.3.1).
+std::vector<Trajectory> StageTrajectories(const PlanningContext& ctx, Occlusion stage,
+                                          const PickPlanResult& result) {
+  std::vector<Trajectory> trajectories;
+  for (std::size_t t = 0; t < result.tubes.size(); ++t) {
+    const TubeClass& cls = result.classes[t];
+    if (cls.too_short || cls.occlusion != stage) continue;
+    std::vector<Trajectory> own =
+        SynthesizeTrajectories(static_cast<std::uint32_t>(t), result.tubes[t], cls, ctx.cell.tube.radius,
+                               ctx.zone, ctx.params.trajectories);
+    trajectories.insert(trajectories.end(), own.begin(), own.end());
+  }
+  return trajectories;
+}
+
+// The (trajectory, grasp) pairs that pass every filter (§5.2.4.1, the tool, the fingers).
+std::vector<Candidate> ViableCandidates(PlanningContext& ctx, const std::vector<Trajectory>& trajectories,
+                                        const PickPlanResult& result, PlanningCounts& counts) {
+  const PlanningParams& params = ctx.params;
+  std::vector<Candidate> viable;
+  for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
+    ThrowIfStopped(ctx.stop, "grasp planning");
+    const Trajectory& trajectory = trajectories[ti];
+    TubeGrasps& tg = ctx.tube_grasps[trajectory.tube_index];
+    if (!tg.synthesized) {
+      tg.grasps = SynthesizeGrasps(result.tubes[trajectory.tube_index], params.grasps);
+      tg.collides.assign(tg.grasps.size(), -1);
+      tg.synthesized = true;
+    }
+    for (std::size_t gi = 0; gi < tg.grasps.size(); ++gi) {
+      const Grasp& grasp = tg.grasps[gi];
+      ++counts.grasp_candidates;
+      if (!InAllowedSection(grasp, trajectory)) {
+        ++counts.rejected_section;
+        continue;
+      }
+      if (!InsideWorkspace(grasp, trajectory, params.filters)) {
+        ++counts.rejected_workspace;
+        continue;
+      }
+      if (params.tool.check &&
+          !ToolClears(ctx.cell.bin, params.tool, grasp.X_BinTcp, grasp.opening_width, trajectory.waypoints)) {
+        ++counts.rejected_tool;
+        continue;
+      }
+      if (tg.collides[gi] < 0) tg.collides[gi] = FingersCollide(grasp, *ctx.raw, params.filters) ? 1 : 0;
+      if (tg.collides[gi] > 0) {
+        ++counts.rejected_fingers;
+        continue;
+      }
+      viable.push_back(Candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi)});
+    }
+  }
+  return viable;
+}
+
+// Which of the stage's trajectories to simulate: in the occluded stages every one with a viable
+// grasp (§5.2.3.2); among non-occluded tubes, with the certainty rule, those of tubes another tube
+// lies on, and only when no tube of the stage has a sure plan.
+std::vector<bool> TrajectoriesToSimulate(const PlanningContext& ctx, Occlusion stage,
+                                         const std::vector<Trajectory>& trajectories,
+                                         const std::vector<Candidate>& viable, const PickPlanResult& result) {
+  std::vector<bool> simulate(trajectories.size(), false);
+  if (ctx.evaluator == nullptr) return simulate;
+  for (const Candidate& c : viable) simulate[c.trajectory] = true;
+  if (stage != Occlusion::kNone) return simulate;
+  if (!ctx.params.certainty.safe_first) return std::vector<bool>(trajectories.size(), false);
+  for (const Candidate& c : viable) {
+    if (result.classes[trajectories[c.trajectory].tube_index].lying_on.empty())
+      return std::vector<bool>(trajectories.size(), false);  // a sure plan exists
+  }
+  return simulate;
+}
+
+// Simulates the marked trajectories in one Evaluate call; displacement per trajectory.
+std::vector<std::optional<double>> Simulate(PlanningContext& ctx, const std::vector<Trajectory>& trajectories,
+                                            const std::vector<bool>& simulate, PickPlanResult* result,
+                                            StageTimer* timer) {
+  std::vector<std::optional<double>> displacement(trajectories.size());
+  std::vector<Trajectory> to_simulate;
+  std::vector<std::size_t> simulated_index;
+  for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
+    if (!simulate[ti]) continue;
+    to_simulate.push_back(trajectories[ti]);
+    simulated_index.push_back(ti);
+  }
+  if (to_simulate.empty()) return displacement;
+  const Clock::time_point t0 = Clock::now();
+  const std::vector<TrajectoryOutcome> outcomes =
+      ctx.evaluator->Evaluate(result->tubes, to_simulate, ctx.seed, ctx.stop);
+  if (outcomes.size() != to_simulate.size()) {
+    throw std::logic_error("TrajectoryEvaluator returned " + std::to_string(outcomes.size()) +
+                           " outcomes for " + std::to_string(to_simulate.size()) + " trajectories");
+  }
+  for (std::size_t k = 0; k < outcomes.size(); ++k)
+    displacement[simulated_index[k]] = outcomes[k].displacement;
+  result->used_simulation = true;
+  result->counts.simulated_trajectories += static_cast<std::uint32_t>(to_simulate.size());
+  timer->Add("simulation", t0);
+  return displacement;
+}
+
+// One candidate stage (thesis §5.2.3–§5.2.4): its trajectories, viable grasps, simulation and
+// plans, appended to result->plans (unranked).
+void PlanStage(PlanningContext& ctx, Occlusion stage, PickPlanResult* result, StageTimer* timer) {
+  ThrowIfStopped(ctx.stop, "planning");
+  Clock::time_point t0 = Clock::now();
+  const std::vector<Trajectory> trajectories = StageTrajectories(ctx, stage, *result);
+  const std::uint32_t first_index = ctx.trajectories_before;
+  ctx.trajectories_before += static_cast<std::uint32_t>(trajectories.size());
+  result->counts.trajectories += static_cast<std::uint32_t>(trajectories.size());
+  timer->Add("trajectories", t0);
+  if (trajectories.empty()) return;
+
+  if (!ctx.raw) {
+    t0 = Clock::now();
+    const auto [z_lo, z_hi] = FingerBandZ(result->tubes, ctx.params.filters);
+    ctx.raw =
+        std::make_unique<RawCloudIndex>(ctx.modeling.raw_Bin, ctx.params.filters.grid_cell_size, z_lo, z_hi);
+    timer->Add("cloud_index", t0);
+  }
+  t0 = Clock::now();
+  const std::vector<Candidate> viable = ViableCandidates(ctx, trajectories, *result, result->counts);
+  timer->Add("grasps", t0);
+  if (viable.empty()) return;
+
+  const std::vector<std::optional<double>> displacement = Simulate(
+      ctx, trajectories, TrajectoriesToSimulate(ctx, stage, trajectories, viable, *result), result, timer);
+
+  t0 = Clock::now();
+  result->plans.reserve(result->plans.size() + viable.size());
+  for (const Candidate& c : viable) {
+    const Trajectory& trajectory = trajectories[c.trajectory];
+    const Tube& tube = result->tubes[trajectory.tube_index];
+    const TubeClass& cls = result->classes[trajectory.tube_index];
+    PickPlan plan;
+    plan.tube_id = tube.id;
+    plan.grasp = ctx.tube_grasps[trajectory.tube_index].grasps[c.grasp];
+    plan.waypoints = trajectory.waypoints;
+    plan.kind = trajectory.kind;
+    plan.escape_direction = trajectory.escape_direction;
+    plan.trajectory_index = first_index + c.trajectory;
+    plan.displacement = displacement[c.trajectory];
+    plan.certainty = plan.displacement                                   ? PlanCertainty::kSimulated
+                     : stage == Occlusion::kNone && cls.lying_on.empty() ? PlanCertainty::kSure
+                                                                         : PlanCertainty::kUnsure;
+    plan.costs = PlanCost(plan.grasp, tube, ctx.max_z, plan.displacement, ctx.params.cost);
+    result->plans.push_back(std::move(plan));
+  }
+  timer->Add("ranking", t0);
+}
+
 }  // namespace
 
 void PlanningParams::Validate() const {
@@ -122,6 +294,8 @@ void PlanningParams::Validate() const {
     throw InvalidArgument(s.str());
   }
   RequirePositive(cost.max_displacement, "planning.cost.max_displacement");
+  RequireNonNegative(certainty.safe_displacement, "planning.certainty.safe_displacement");
+  RequireNonNegative(certainty.contact_margin, "planning.certainty.contact_margin");
   RequireFinite(empty_min_height, "planning.empty_min_height");
 }
 
@@ -198,124 +372,38 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
     return result;
   }
 
-  const double max_z = MaxHeight(modeling, result.tubes);
-  const SafetyZone zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
-  std::unique_ptr<RawCloudIndex> raw;  // built on first use
-  std::vector<TubeGrasps> tube_grasps(result.tubes.size());
+  PlanningContext ctx(modeling, cell, params, evaluator, seed, stop);
+  ctx.max_z = MaxHeight(modeling, result.tubes);
+  ctx.zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
+  ctx.tube_grasps.resize(result.tubes.size());
+  for (std::size_t t = 0; t < result.tubes.size(); ++t) {
+    TubeClass& cls = result.classes[t];
+    if (cls.too_short || cls.occlusion != Occlusion::kNone) continue;
+    cls.lying_on = TubesLyingOn(result.tubes, t, params.certainty);
+    if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
+  }
 
   std::vector<Occlusion> stages = {Occlusion::kNone, Occlusion::kWeak};
   if (params.strongly_occluded_candidates) stages.push_back(Occlusion::kStrong);
   for (const Occlusion stage : stages) {
-    ThrowIfStopped(stop, "planning");
-    // 2. Trajectories of this stage's candidate tubes.
-    t0 = Clock::now();
-    std::vector<Trajectory> trajectories;
-    for (std::size_t t = 0; t < result.tubes.size(); ++t) {
-      const TubeClass& cls = result.classes[t];
-      if (cls.too_short || cls.occlusion != stage) continue;
-      std::vector<Trajectory> own = SynthesizeTrajectories(static_cast<std::uint32_t>(t), result.tubes[t],
-                                                           cls, cell.tube.radius, zone, params.trajectories);
-      trajectories.insert(trajectories.end(), own.begin(), own.end());
-    }
-    counts.trajectories += static_cast<std::uint32_t>(trajectories.size());
-    timer.Add("trajectories", t0);
-    if (trajectories.empty()) continue;
-
-    // 3. Grasps and filters.
-    if (!raw) {
-      t0 = Clock::now();
-      const auto [z_lo, z_hi] = FingerBandZ(result.tubes, params.filters);
-      raw = std::make_unique<RawCloudIndex>(modeling.raw_Bin, params.filters.grid_cell_size, z_lo, z_hi);
-      timer.Add("cloud_index", t0);
-    }
-    t0 = Clock::now();
-    std::vector<Candidate> viable;
-    std::vector<bool> trajectory_viable(trajectories.size(), false);
-    for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
-      ThrowIfStopped(stop, "grasp planning");
-      const Trajectory& trajectory = trajectories[ti];
-      TubeGrasps& tg = tube_grasps[trajectory.tube_index];
-      if (!tg.synthesized) {
-        tg.grasps = SynthesizeGrasps(result.tubes[trajectory.tube_index], params.grasps);
-        tg.collides.assign(tg.grasps.size(), -1);
-        tg.synthesized = true;
-      }
-      for (std::size_t gi = 0; gi < tg.grasps.size(); ++gi) {
-        const Grasp& grasp = tg.grasps[gi];
-        ++counts.grasp_candidates;
-        if (!InAllowedSection(grasp, trajectory)) {
-          ++counts.rejected_section;
-          continue;
-        }
-        if (!InsideWorkspace(grasp, trajectory, params.filters)) {
-          ++counts.rejected_workspace;
-          continue;
-        }
-        if (params.tool.check &&
-            !ToolClears(cell.bin, params.tool, grasp.X_BinTcp, grasp.opening_width, trajectory.waypoints)) {
-          ++counts.rejected_tool;
-          continue;
-        }
-        if (tg.collides[gi] < 0) tg.collides[gi] = FingersCollide(grasp, *raw, params.filters) ? 1 : 0;
-        if (tg.collides[gi] > 0) {
-          ++counts.rejected_fingers;
-          continue;
-        }
-        viable.push_back(Candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi)});
-        trajectory_viable[ti] = true;
-      }
-    }
-    timer.Add("grasps", t0);
-    if (viable.empty()) continue;
-
-    // Simulation of the trajectories that have a viable grasp (never for non-occluded tubes).
-    std::vector<std::optional<double>> displacement(trajectories.size());
-    if (stage != Occlusion::kNone && evaluator != nullptr) {
-      t0 = Clock::now();
-      std::vector<Trajectory> to_simulate;
-      std::vector<std::size_t> simulated_index;
-      for (std::size_t ti = 0; ti < trajectories.size(); ++ti) {
-        if (!trajectory_viable[ti]) continue;
-        to_simulate.push_back(trajectories[ti]);
-        simulated_index.push_back(ti);
-      }
-      const std::vector<TrajectoryOutcome> outcomes =
-          evaluator->Evaluate(result.tubes, to_simulate, seed, stop);
-      if (outcomes.size() != to_simulate.size()) {
-        throw std::logic_error("TrajectoryEvaluator returned " + std::to_string(outcomes.size()) +
-                               " outcomes for " + std::to_string(to_simulate.size()) + " trajectories");
-      }
-      for (std::size_t k = 0; k < outcomes.size(); ++k)
-        displacement[simulated_index[k]] = outcomes[k].displacement;
-      result.used_simulation = true;
-      counts.simulated_trajectories += static_cast<std::uint32_t>(to_simulate.size());
-      timer.Add("simulation", t0);
-    }
-
-    // 4. Costs and ranking.
-    t0 = Clock::now();
-    result.plans.reserve(viable.size());
-    for (const Candidate& c : viable) {
-      const Trajectory& trajectory = trajectories[c.trajectory];
-      const Tube& tube = result.tubes[trajectory.tube_index];
-      const Grasp& grasp = tube_grasps[trajectory.tube_index].grasps[c.grasp];
-      PickPlan plan;
-      plan.tube_id = tube.id;
-      plan.grasp = grasp;
-      plan.waypoints = trajectory.waypoints;
-      plan.kind = trajectory.kind;
-      plan.escape_direction = trajectory.escape_direction;
-      plan.trajectory_index = c.trajectory;
-      plan.displacement = displacement[c.trajectory];
-      plan.costs = PlanCost(grasp, tube, max_z, plan.displacement, params.cost);
-      result.plans.push_back(std::move(plan));
-    }
-    RankPlans(&result.plans);
-    if (params.max_plans > 0 && result.plans.size() > params.max_plans) result.plans.resize(params.max_plans);
-    result.planned_class = stage;
-    timer.Add("ranking", t0);
-    break;
+    PlanStage(ctx, stage, &result, &timer);
+    if (result.plans.empty()) continue;
+    // The thesis stops at the first stage with a plan; the certainty rule goes on until one is safe.
+    if (!params.certainty.safe_first) break;
+    const auto safe = [&](const PickPlan& p) { return PlanIsSafe(p, params.certainty); };
+    if (std::any_of(result.plans.begin(), result.plans.end(), safe)) break;
   }
+
+  t0 = Clock::now();
+  RankPlans(&result.plans, params.certainty);
+  if (params.max_plans > 0 && result.plans.size() > params.max_plans) result.plans.resize(params.max_plans);
+  if (!result.plans.empty()) {
+    for (std::size_t t = 0; t < result.tubes.size(); ++t) {
+      if (result.tubes[t].id == result.plans.front().tube_id)
+        result.planned_class = result.classes[t].occlusion;
+    }
+  }
+  timer.Add("ranking", t0);
   counts.plans = static_cast<std::uint32_t>(result.plans.size());
   result.total_seconds = SecondsSince(start);
   return result;

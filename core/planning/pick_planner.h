@@ -11,6 +11,7 @@
 #include "core/planning/grasp_filters.h"
 #include "core/planning/grasp_ranking.h"
 #include "core/planning/grasp_synthesis.h"
+#include "core/planning/plan_certainty.h"
 #include "core/planning/tool_clearance.h"
 #include "core/planning/trajectory.h"
 #include "core/planning/trajectory_synthesis.h"
@@ -29,6 +30,9 @@ struct PlanningParams {
   /// not executable and is rejected, so the stages fall through to other tubes. Beyond the thesis.
   ToolParams tool;
   CostParams cost;
+  /// The certainty rule: a plan that needs luck does not outrank a sure one unless its simulated
+  /// displacement says it is as safe (issue 14 item 6). Beyond the thesis.
+  CertaintyParams certainty;
   /// Bin-empty test: the bin is empty when no tube was modeled and at most this many filtered
   /// points lie higher than empty_min_height.
   std::uint32_t empty_max_points = 50;
@@ -53,6 +57,8 @@ struct PlanningCounts {
   std::uint32_t non_occluded = 0;
   std::uint32_t weakly_occluded = 0;
   std::uint32_t strongly_occluded = 0;
+  /// Non-occluded tubes another modeled tube lies on (TubeClass::lying_on).
+  std::uint32_t non_occluded_lain_on = 0;
   /// Trajectories synthesized, and those sent to the evaluator.
   std::uint32_t trajectories = 0;
   std::uint32_t simulated_trajectories = 0;
@@ -77,7 +83,7 @@ struct PickPlanResult {
   bool bin_empty = false;
   /// The evaluator was called.
   bool used_simulation = false;
-  /// Occlusion class of the tubes the plans come from; kUnspecified when there is no plan.
+  /// Occlusion class of the best plan's tube; kUnspecified when there is no plan.
   Occlusion planned_class = Occlusion::kUnspecified;
   PlanningCounts counts;
   /// "classification", "cloud_index", "trajectories", "grasps", "simulation", "ranking".

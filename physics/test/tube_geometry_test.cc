@@ -1,5 +1,8 @@
 #include "physics/tube_geometry.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -46,6 +49,38 @@ TEST(TubeGeometry, LinearTubeHelpers) {
   const Tube core = tube.ToTube();
   EXPECT_EQ(core.id, 7u);
   EXPECT_NEAR(core.length(), 0.3, kTol);
+}
+
+TEST(TubeGeometry, TreeBecomesATubeGraph) {
+  // A Y: trunk 1-2-3 (0.2 m), branches 3-4 (0.1 m) and 3-5-6 (0.15 m) from node 3.
+  TubeGeometry tube = Chain({{1, {0, 0, 0}}, {2, {0.1, 0, 0}}, {3, {0.2, 0, 0}}, {4, {0.3, 0.0, 0}}});
+  const TubeGeometry fork = Chain({{3, {0.2, 0, 0}}, {5, {0.25, 0.05, 0}}, {6, {0.25, 0.15, 0}}});
+  tube.nodes.push_back(fork.nodes[1]);
+  tube.nodes.push_back(fork.nodes[2]);
+  tube.edges.insert(tube.edges.end(), fork.edges.begin(), fork.edges.end());
+  ASSERT_FALSE(tube.IsLinear());
+  const Tube core = tube.ToTube();
+  EXPECT_EQ(core.id, 7u);
+  ASSERT_EQ(core.cylinders.size(), 5u);
+  ASSERT_EQ(core.nodes.size(), 4u);     // ends 1, 4, 6 and the junction 3
+  ASSERT_EQ(core.branches.size(), 3u);  // 1→3 (two edges), 3→4, 3→6 (two edges)
+  EXPECT_TRUE(core.branched());
+  EXPECT_NEAR(core.length(), 0.3 + 0.05 * std::sqrt(2.0) + 0.1, 1e-9);
+  std::vector<std::uint32_t> counts;
+  for (const TubeBranch& b : core.branches) {
+    counts.push_back(b.cylinder_count);
+    const Cylinder& first = core.cylinders[b.first_cylinder];
+    const Cylinder& last = core.cylinders[b.first_cylinder + b.cylinder_count - 1];
+    EXPECT_TRUE(first.start.isApprox(core.nodes[b.from_node].p_Bin));
+    EXPECT_TRUE(last.end.isApprox(core.nodes[b.to_node].p_Bin));
+  }
+  std::sort(counts.begin(), counts.end());
+  EXPECT_EQ(counts, (std::vector<std::uint32_t>{1, 2, 2}));
+
+  TubeGeometry loop = Chain({{1, {0, 0, 0}}, {2, {0.1, 0, 0}}, {3, {0.1, 0.1, 0}}, {1, {0, 0, 0}}});
+  loop.nodes.pop_back();
+  EXPECT_THAT([&] { (void)loop.ToTube(); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("tube 7 is not a tree")));
 }
 
 TEST(TubeGeometry, CentrelineStartsAtFirstOrderEvenWhenStoredReversed) {

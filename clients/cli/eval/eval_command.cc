@@ -21,6 +21,7 @@
 #include "core/common/thread_budget.h"
 #include "core/evaluation/virtual_labelling.h"
 #include "core/modeling/model_tubes.h"
+#include "physics/trajectory_simulator.h"
 #include "physics/tube_config_io.h"
 #include "viewer/view_page.h"
 #include "wire/response_convert.h"
@@ -45,6 +46,8 @@ struct EvalOptions {
   std::uint32_t pictures_per_count = 2;
   /// Cloud points of each scene's 3-D page; 0 = no pages.
   std::uint32_t view_points = 50'000;
+  /// Plan every scene and check the best plan against the ground truth.
+  bool plans = false;
   std::string command_line;
 };
 
@@ -232,9 +235,18 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
   out.tube_count = static_cast<std::uint32_t>(tubes_Bin.size());
   out.input_points = points_Sensor.size();
 
-  const ModelingResult result = ModelTubes(
-      MakeModelingInput(points_Sensor, unit, cell, o.common.seed, RawRegion::None()), params.modeling);
+  // Planning needs the raw points of its finger test; the modeling is the same either way.
+  const RawRegion raw = o.plans ? RawRegionForPlanning(params.planning, cell.bin) : RawRegion::None();
+  const ModelingResult result =
+      ModelTubes(MakeModelingInput(points_Sensor, unit, cell, o.common.seed, raw), params.modeling);
   out.evaluation = EvaluateScene(result, labels, out.tube_count, eval_params);
+  if (o.plans) {
+    physics::BulletTrajectoryEvaluator evaluator(
+        physics::SimParamsForCell({}, cell, params.planning.cost.max_displacement,
+                                  static_cast<int>(std::max(1u, params.modeling.threads))));
+    const PickPlanResult plan = PlanPick(result, cell, params.planning, &evaluator, o.common.seed);
+    out.plan_check = CheckBestPlan(plan, tubes_Bin, cell, params.planning);
+  }
   out.snapshot = MakeSnapshot(result, labels, tubes_Bin, eval_params, cell.bin);
   if (o.view_points > 0) {
     out.view_file = WriteScenePage(out, points_Sensor, unit, cell, result, params, o);
@@ -324,7 +336,11 @@ void Run(const EvalOptions& o) {
       try {
         results[i] = EvaluateJob(scene_jobs[i], o, cell, params, eval_params);
         const SceneEvaluation& e = results[i]->evaluation;
-        progress.Advance(fmt::format("{} {}/{} correct", scene_jobs[i].name, e.correct, e.real_tube_count));
+        std::string lifted;
+        if (results[i]->plan_check)
+          lifted = fmt::format(", best plan lifts {}", results[i]->plan_check->lifted);
+        progress.Advance(
+            fmt::format("{} {}/{} correct{}", scene_jobs[i].name, e.correct, e.real_tube_count, lifted));
       } catch (...) {
         failures[i] = std::current_exception();
         progress.Advance(scene_jobs[i].name + " FAILED");
@@ -371,6 +387,18 @@ void Run(const EvalOptions& o) {
       a.scenes, a.real_tubes, 100.0 * a.correct_fraction,
       100.0 * a.total_partially_correct / std::max<std::uint32_t>(1, a.real_tubes), a.micro_recall,
       FormatDuration(run.wall_seconds));
+  if (o.plans) {
+    std::vector<const PlanCheck*> checks;
+    for (const EvaluatedScene& s : run.scenes) checks.push_back(&*s.plan_check);
+    const PlanCheckSummary c = SummarizePlanChecks(checks);
+    fmt::print(
+        "best plans: {} of {} scenes planned ({} sure, {} simulated, {} unsure); on a free real tube {}, on "
+        "a "
+        "tube lain on while a free one existed {}, off every tube {}; the check lifted it alone {}, with "
+        "others {}, not at all {}\n",
+        c.planned, c.scenes, c.sure, c.simulated, c.unsure, c.grasped_free, c.grasped_lain_on_while_free,
+        c.off_tube, c.lifted_alone, c.lifted_several, c.lifted_none);
+  }
   fmt::print("wrote {}/report.md, report.json, images/\n", o.report_dir);
 }
 
@@ -422,6 +450,9 @@ void AddEvalCommand(CLI::App& app) {
   cmd->add_option("--view-points", o->view_points,
                   "Cloud points in each scene's 3-D page (views/NAME.html); 0 = write no pages")
       ->capture_default_str();
+  cmd->add_flag("--plans", o->plans,
+                "Also plan every scene (with simulation) and check the best plan against the ground truth: "
+                "the real tube it grasps, whether a tube lies on it, and a Bullet lift of the real tubes");
   cmd->add_option("--pictures-per-count", o->pictures_per_count,
                   "Top-down pictures per tube count (the worst and a typical scene)")
       ->check(CLI::Range(0, 10))

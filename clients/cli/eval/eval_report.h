@@ -1,11 +1,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "clients/cli/eval/plan_check.h"
 #include "core/common/cell_config.h"
 #include "core/common/types.h"
 #include "core/evaluation/aggregation.h"
@@ -40,6 +42,8 @@ struct EvaluatedScene {
   std::uint64_t input_points = 0;
   SceneEvaluation evaluation;
   SceneSnapshot snapshot;
+  /// The best plan against the ground truth (`--plans`).
+  std::optional<PlanCheck> plan_check;
   /// Its 3-D page relative to the report directory ("views/n10_s10005.html"); empty = none written.
   std::string view_file;
 };

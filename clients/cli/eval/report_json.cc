@@ -52,6 +52,21 @@ json AggregateJson(const EvaluationAggregate& a) {
               {"max_total_seconds", a.max_total_seconds}};
 }
 
+json PlanCheckJson(const std::optional<PlanCheck>& c) {
+  if (!c) return nullptr;
+  if (!c->planned) return json{{"planned", false}, {"free_real_tubes", c->free_real_tubes}};
+  return json{{"planned", true},
+              {"certainty", c->certainty},
+              {"trajectory", c->trajectory},
+              {"modeled_class", c->modeled_class},
+              {"real_tube", c->real_tube >= 0 ? json(c->real_tube) : json(nullptr)},
+              {"grasp_offset", c->grasp_offset},
+              {"real_tube_free", c->real_tube_free},
+              {"free_real_tubes", c->free_real_tubes},
+              {"lifted", c->lifted},
+              {"displacement", c->displacement}};
+}
+
 json SceneJson(const EvaluatedScene& s) {
   const SceneEvaluation& e = s.evaluation;
   json real = json::array();
@@ -91,6 +106,7 @@ json SceneJson(const EvaluatedScene& s) {
   confusion["counts"] = rows;
   return json{{"name", s.name},
               {"source", s.source},
+              {"best_plan", PlanCheckJson(s.plan_check)},
               {"view", s.view_file.empty() ? json(nullptr) : json(s.view_file)},
               {"tube_count", s.tube_count},
               {"scene_seed", s.scene_seed >= 0 ? json(s.scene_seed) : json(nullptr)},

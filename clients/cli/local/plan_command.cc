@@ -51,19 +51,24 @@ void Run(const PlanOptions& o) {
   fmt::print("modeling {:.3f} s: {} tubes; planning {:.3f} s: {} plans{}{}\n", modeling.total_seconds,
              modeling.tubes.size(), plan.total_seconds, plan.plans.size(),
              plan.used_simulation ? " (trajectories simulated)" : "", plan.bin_empty ? "; BIN EMPTY" : "");
-  fmt::print("{:>5} {:>9} {:>8} {:>9}\n", "tube", "length_m", "branches", "occlusion");
-  for (const Tube& t : plan.tubes)
-    fmt::print("{:>5} {:>9.3f} {:>8} {:>9}\n", t.id, t.length(), BranchesOf(t).size(),
-               OcclusionName(t.occlusion));
-  fmt::print("{:>4} {:>5} {:>17} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
-             "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
+  fmt::print("{:>5} {:>9} {:>8} {:>9}  {}\n", "tube", "length_m", "branches", "occlusion", "lain on by");
+  for (std::size_t i = 0; i < plan.tubes.size(); ++i) {
+    const Tube& t = plan.tubes[i];
+    std::string lain_on;
+    for (std::uint32_t u : plan.classes[i].lying_on) lain_on += fmt::format("{} ", plan.tubes[u].id);
+    fmt::print("{:>5} {:>9.3f} {:>8} {:>9}  {}\n", t.id, t.length(), BranchesOf(t).size(),
+               OcclusionName(t.occlusion), lain_on.empty() ? "-" : lain_on);
+  }
+  fmt::print("{:>4} {:>5} {:>17} {:>9} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
+             "certainty", "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
   for (std::size_t i = 0; i < plan.plans.size() && i < o.show; ++i) {
     const PickPlan& p = plan.plans[i];
     const Eigen::Vector3d g = p.grasp.p_Bin_grasp;
-    fmt::print("{:>4} {:>5} {:>17} ({:+.3f}, {:+.3f}, {:+.3f}) {:>7.3f} {:>7.3f} {:>7.3f} {:>7.3f} {:>9}\n",
-               i, p.tube_id, ToString(p.kind), g.x(), g.y(), g.z(), p.costs.height, p.costs.centre,
-               p.costs.trajectory, p.costs.total,
-               p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
+    fmt::print(
+        "{:>4} {:>5} {:>17} {:>9} ({:+.3f}, {:+.3f}, {:+.3f}) {:>7.3f} {:>7.3f} {:>7.3f} {:>7.3f} {:>9}\n", i,
+        p.tube_id, ToString(p.kind), ToString(p.certainty), g.x(), g.y(), g.z(), p.costs.height,
+        p.costs.centre, p.costs.trajectory, p.costs.total,
+        p.displacement ? fmt::format("{:.4f}", *p.displacement) : "-");
   }
   if (!o.json_path.empty()) {
     WriteTextFile(o.json_path, ToJson(ToPlanPickResponse(plan, modeling, common.profile, common.seed)));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -334,7 +335,7 @@ PickPlan Plan(std::uint32_t tube, double total, std::uint32_t trajectory, double
 TEST(GraspRanking, BestFirstWithDeterministicTies) {
   std::vector<PickPlan> plans = {Plan(2, 0.3, 0, 0.1), Plan(1, 0.1, 3, 0.2), Plan(0, 0.1, 5, 0.2),
                                  Plan(0, 0.1, 4, 0.3), Plan(0, 0.1, 4, 0.1), Plan(3, 0.05, 9, 0.0)};
-  RankPlans(&plans);
+  RankPlans(&plans, CertaintyParams{});
   ASSERT_EQ(plans.size(), 6u);
   EXPECT_EQ(plans[0].tube_id, 3u);
   // Equal totals 0.1: tube 0 before tube 1; within tube 0, trajectory 4 before 5; then curve.
@@ -345,6 +346,83 @@ TEST(GraspRanking, BestFirstWithDeterministicTies) {
   EXPECT_EQ(plans[3].trajectory_index, 5u);
   EXPECT_EQ(plans[4].tube_id, 1u);
   EXPECT_EQ(plans[5].tube_id, 2u);
+}
+
+}  // namespace
+}  // namespace tubepick
+
+namespace tubepick {
+namespace {
+
+PickPlan PlanOf(std::uint32_t tube, double total, PlanCertainty certainty, std::optional<double> disp = {}) {
+  PickPlan p;
+  p.tube_id = tube;
+  p.costs.total = total;
+  p.certainty = certainty;
+  p.displacement = disp;
+  return p;
+}
+
+std::vector<std::uint32_t> TubeOrder(const std::vector<PickPlan>& plans) {
+  std::vector<std::uint32_t> order;
+  for (const PickPlan& p : plans) order.push_back(p.tube_id);
+  return order;
+}
+
+TEST(GraspRanking, SafePlansOutrankPlansThatNeedLuck) {
+  const std::vector<PickPlan> plans = {
+      PlanOf(0, 0.40, PlanCertainty::kSure),             // safe
+      PlanOf(1, 0.10, PlanCertainty::kUnsure),           // occluded, not simulated: T_cost 0
+      PlanOf(2, 0.20, PlanCertainty::kSimulated, 0.02),  // simulated, 2 cm: safe
+      PlanOf(3, 0.05, PlanCertainty::kSimulated, 0.30),  // simulated, 30 cm: not safe
+      PlanOf(4, 0.30, PlanCertainty::kSimulated, 0.05),  // exactly the threshold: safe
+  };
+  const CertaintyParams rule;
+  EXPECT_TRUE(PlanIsSafe(plans[0], rule));
+  EXPECT_FALSE(PlanIsSafe(plans[1], rule));
+  EXPECT_TRUE(PlanIsSafe(plans[2], rule));
+  EXPECT_FALSE(PlanIsSafe(plans[3], rule));
+  EXPECT_TRUE(PlanIsSafe(plans[4], rule));
+
+  std::vector<PickPlan> ranked = plans;
+  RankPlans(&ranked, rule);
+  EXPECT_EQ(TubeOrder(ranked), (std::vector<std::uint32_t>{2, 4, 0, 3, 1}));
+
+  // The threshold is the parameter: at 1 cm only the sure plan is safe.
+  CertaintyParams strict;
+  strict.safe_displacement = 0.01;
+  ranked = plans;
+  RankPlans(&ranked, strict);
+  EXPECT_EQ(TubeOrder(ranked), (std::vector<std::uint32_t>{0, 3, 1, 2, 4}));
+
+  // Without the rule: G_cost alone (the thesis).
+  CertaintyParams off;
+  off.safe_first = false;
+  ranked = plans;
+  RankPlans(&ranked, off);
+  EXPECT_EQ(TubeOrder(ranked), (std::vector<std::uint32_t>{3, 1, 2, 4, 0}));
+}
+
+TEST(PlanCertainty, TubesLyingOnNeedContactFromAbove) {
+  using namespace testing_planning;  // NOLINT
+  const std::vector<Tube> tubes = {
+      MakeTube(0, {FlatCylinder(-0.2, 0.05, 0.2, 0.05, 1)}),
+      // Across tube 0's end, resting on it (axis 2r above tube 0's axis).
+      MakeTube(1, {FlatCylinder(0.17, -0.1, 0.17, 0.2, 2, 3.0 * kR)}),
+      // Beside tube 0 on the floor, touching it: not on it.
+      MakeTube(2, {FlatCylinder(-0.2, 0.05 + 2.0 * kR, 0.1, 0.05 + 2.0 * kR, 3)}),
+      // Above tube 0 but 3 cm clear of it: not on it.
+      MakeTube(3, {FlatCylinder(-0.1, -0.1, -0.1, 0.2, 4, 3.0 * kR + 0.03)}),
+  };
+  const CertaintyParams params;
+  EXPECT_EQ(TubesLyingOn(tubes, 0, params), (std::vector<std::uint32_t>{1}));
+  EXPECT_TRUE(TubesLyingOn(tubes, 1, params).empty());
+  EXPECT_TRUE(TubesLyingOn(tubes, 2, params).empty());
+  EXPECT_TRUE(TubesLyingOn(tubes, 3, params).empty());
+  // Within the margin: 3 cm of margin reaches tube 3.
+  CertaintyParams wide;
+  wide.contact_margin = 0.031;
+  EXPECT_EQ(TubesLyingOn(tubes, 0, wide), (std::vector<std::uint32_t>{1, 3}));
 }
 
 }  // namespace

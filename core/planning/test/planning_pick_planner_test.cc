@@ -1,5 +1,6 @@
 #include "core/planning/pick_planner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -292,6 +293,108 @@ void ExpectInvalid(const PlanningParams& params, const std::string& key,
   }
 }
 
+// Tube 0 on the floor (non-occluded: one segment), tube 1 across its end, resting on it (also
+// non-occluded, nothing on it). Tube 2, if asked for, weakly occluded on the floor far from both.
+std::vector<Tube> LainOnTubes(bool with_weak) {
+  std::vector<Tube> tubes = {MakeTube(0, {FlatCylinder(-0.2, 0.05, 0.2, 0.05, 1)}),
+                             MakeTube(1, {FlatCylinder(0.17, -0.1, 0.17, 0.2, 2, 3.0 * kR)})};
+  if (with_weak) {
+    tubes.push_back(
+        MakeTube(2, {FlatCylinder(-0.2, -0.2, -0.02, -0.2, 3), FlatCylinder(0.02, -0.2, 0.2, -0.2, 4)}));
+  }
+  return tubes;
+}
+
+// Points along both fingers of every grasp on tube 1 (x = 0.17 ± 0.0275, z = 0.07).
+Points BlockTube1() {
+  Points pts;
+  for (double y = -0.15; y <= 0.25; y += 0.0005) {
+    pts.emplace_back(0.17 + 0.0275, y, 0.07);
+    pts.emplace_back(0.17 - 0.0275, y, 0.07);
+  }
+  return pts;
+}
+
+CellConfig CellOf40cmTubes() {
+  CellConfig cell;
+  cell.tube.length = 0.40;  // minimum accepted length 0.25 m
+  return cell;
+}
+
+TEST(PickPlanner, ATubeLainOnDoesNotOutrankAFreeOne) {
+  FakeEvaluator evaluator([](const Trajectory&) { return 0.0; });
+  const PickPlanResult r =
+      PlanPick(Model(LainOnTubes(false)), CellOf40cmTubes(), PlanningParams{}, &evaluator, 0);
+  ASSERT_EQ(r.classes.size(), 2u);
+  EXPECT_EQ(r.counts.non_occluded, 2u);
+  EXPECT_EQ(r.counts.non_occluded_lain_on, 1u);
+  EXPECT_EQ(r.classes[0].lying_on, (std::vector<std::uint32_t>{1}));
+  EXPECT_TRUE(r.classes[1].lying_on.empty());
+  EXPECT_EQ(evaluator.calls, 0);  // a sure plan exists: nothing to simulate
+  ASSERT_FALSE(r.plans.empty());
+  // Tube 0 is lower (H 0.25 against 0.75) and has the lower G_cost, but tube 1 lies on it.
+  EXPECT_EQ(r.plans.front().tube_id, 1u);
+  EXPECT_EQ(r.plans.front().certainty, PlanCertainty::kSure);
+  // H 0.75; the grasps nearest the middle (curve 0.15 of 0.30) are 1 cm from it.
+  EXPECT_NEAR(r.plans.front().costs.total, 0.2 * 0.75 + 0.5 * 0.01 / 0.15, 1e-9);
+  double tube0_best = 1.0;
+  for (const PickPlan& p : r.plans) {
+    if (p.tube_id != 0) continue;
+    tube0_best = std::min(tube0_best, p.costs.total);
+    EXPECT_EQ(p.certainty, PlanCertainty::kUnsure);
+  }
+  EXPECT_NEAR(tube0_best, 0.05, 1e-9);  // H 0.25, the middle grasp
+
+  // The thesis' ranking (G_cost alone) takes the lower tube.
+  PlanningParams thesis;
+  thesis.certainty.safe_first = false;
+  const PickPlanResult t = PlanPick(Model(LainOnTubes(false)), CellOf40cmTubes(), thesis, &evaluator, 0);
+  ASSERT_FALSE(t.plans.empty());
+  EXPECT_EQ(t.plans.front().tube_id, 0u);
+  EXPECT_EQ(evaluator.calls, 0);
+}
+
+TEST(PickPlanner, ATubeLainOnIsSimulatedWhenNoSurePlanExists) {
+  // Tube 1 cannot be grasped: tube 0's upward lift is simulated, and 1 cm of displacement is safe.
+  FakeEvaluator gentle([](const Trajectory&) { return 0.01; });
+  const PickPlanResult r =
+      PlanPick(Model(LainOnTubes(true), BlockTube1()), CellOf40cmTubes(), PlanningParams{}, &gentle, 0);
+  EXPECT_EQ(gentle.calls, 1);
+  ASSERT_EQ(gentle.trajectories_seen.size(), 1u);
+  EXPECT_EQ(gentle.trajectories_seen[0].tube_index, 0u);
+  EXPECT_EQ(gentle.trajectories_seen[0].kind, TrajectoryKind::kUpward);
+  ASSERT_FALSE(r.plans.empty());
+  EXPECT_EQ(r.plans.front().tube_id, 0u);
+  EXPECT_EQ(r.plans.front().certainty, PlanCertainty::kSimulated);
+  EXPECT_EQ(r.planned_class, Occlusion::kNone);
+  for (const PickPlan& p : r.plans) EXPECT_EQ(p.tube_id, 0u);  // a safe plan: no further stage
+
+  // 10 cm is not safe: the weak stage is planned too, and its 2 cm escape outranks tube 0's lift
+  // although that lift's G_cost is lower.
+  FakeEvaluator rough([](const Trajectory& t) {
+    if (t.tube_index == 0) return 0.10;
+    return t.kind == TrajectoryKind::kUpward ? 0.30 : 0.02;
+  });
+  const PickPlanResult w =
+      PlanPick(Model(LainOnTubes(true), BlockTube1()), CellOf40cmTubes(), PlanningParams{}, &rough, 0);
+  EXPECT_EQ(rough.calls, 2);
+  ASSERT_FALSE(w.plans.empty());
+  const PickPlan& best = w.plans.front();
+  EXPECT_EQ(best.tube_id, 2u);
+  EXPECT_EQ(best.kind, TrajectoryKind::kEscape);
+  EXPECT_EQ(best.certainty, PlanCertainty::kSimulated);
+  EXPECT_EQ(w.planned_class, Occlusion::kWeak);
+  double tube0_best = 1.0;
+  for (const PickPlan& p : w.plans) {
+    if (p.tube_id == 0) tube0_best = std::min(tube0_best, p.costs.total);
+    if (p.tube_id == 2) {
+      EXPECT_GE(p.trajectory_index, 2u);  // after the two upward lifts of stage 1
+    }
+  }
+  EXPECT_LT(tube0_best, best.costs.total);
+  EXPECT_EQ(w.counts.simulated_trajectories, 4u);  // tube 0 upward; tube 2 upward and two escapes
+}
+
 TEST(PickPlanner, InvalidParamsAreNamed) {
   EXPECT_NO_THROW(PlanningParams{}.Validate());
   PlanningParams p;
@@ -307,6 +410,9 @@ TEST(PickPlanner, InvalidParamsAreNamed) {
   p = PlanningParams{};
   p.cost.max_displacement = 0.0;
   ExpectInvalid(p, "planning.cost.max_displacement");
+  p = PlanningParams{};
+  p.certainty.safe_displacement = -0.01;
+  ExpectInvalid(p, "planning.certainty.safe_displacement");
   p = PlanningParams{};
   p.filters.workspace_min.z() = 2.0;
   ExpectInvalid(p, "planning.filters.workspace_min[2]: 2 exceeds workspace_max[2] 1");
