@@ -105,6 +105,23 @@ v1::PlanPickRequest AsPlanPick(const v1::ModelTubesRequest& request) {
   return out;
 }
 
+TubeTopology TopologyOf(v1::TubeTopology topology, TubeTopology configured, const std::string& field) {
+  switch (topology) {
+    case v1::TUBE_TOPOLOGY_UNSPECIFIED:
+      return configured;
+    case v1::TUBE_TOPOLOGY_LINEAR:
+      return TubeTopology::kLinear;
+    case v1::TUBE_TOPOLOGY_BRANCHED:
+      return TubeTopology::kBranched;
+    case v1::TUBE_TOPOLOGY_AUTO:
+      return TubeTopology::kAuto;
+    default:
+      break;
+  }
+  throw InvalidArgument(field + ": unknown value " + std::to_string(static_cast<int>(topology)) +
+                        " (expected TUBE_TOPOLOGY_LINEAR, _BRANCHED or _AUTO)");
+}
+
 }  // namespace
 
 std::string_view CheckCloudBytes(std::string_view xyz, std::uint64_t max_points, const std::string& field) {
@@ -151,6 +168,7 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   out.tube.length = cell->tube_length();
   RequireRange(cell->tube_mass(), kMinTubeMass, kMaxTubeMass, false, f + "tube_mass", "kg");
   out.tube.mass = cell->tube_mass();
+  out.tube.topology = TopologyOf(cell->tube_topology(), defaults.cell.tube.topology, f + "tube_topology");
 
   if (!cell->has_place_pose()) throw InvalidArgument(f + "place_pose: required when the cell is given");
   out.place.X_BinPlace = FromProto(cell->place_pose(), f + "place_pose");

@@ -196,6 +196,9 @@ v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isome
   out.set_tube_radius(cell.tube.radius);
   out.set_tube_length(cell.tube.length);
   out.set_tube_mass(cell.tube.mass);
+  out.set_tube_topology(cell.tube.topology == TubeTopology::kBranched ? v1::TUBE_TOPOLOGY_BRANCHED
+                        : cell.tube.topology == TubeTopology::kAuto   ? v1::TUBE_TOPOLOGY_AUTO
+                                                                      : v1::TUBE_TOPOLOGY_LINEAR);
   *out.mutable_place_pose() = ToProto(cell.place.X_BinPlace);
   return out;
 }
@@ -208,6 +211,20 @@ std::string TrajectoryKindName(v1::TrajectoryKind kind) {
       return "escape";
     case v1::TRAJECTORY_KIND_OCCLUSION_ESCAPE:
       return "occlusion_escape";
+    default:
+      break;
+  }
+  return "unspecified";
+}
+
+std::string CertaintyName(v1::PlanCertainty certainty) {
+  switch (certainty) {
+    case v1::PLAN_CERTAINTY_SURE:
+      return "sure";
+    case v1::PLAN_CERTAINTY_SIMULATED:
+      return "simulated";
+    case v1::PLAN_CERTAINTY_UNSURE:
+      return "unsure";
     default:
       break;
   }

@@ -52,6 +52,8 @@ v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isome
 
 /// "upward", "escape", "occlusion_escape", "unspecified" (records and tables).
 std::string TrajectoryKindName(v1::TrajectoryKind kind);
+/// "sure", "simulated", "unsure", "unspecified" (records and tables).
+std::string CertaintyName(v1::PlanCertainty certainty);
 /// "none", "single", "multiple", "unspecified".
 std::string HeldOutcomeName(v1::HeldOutcome outcome);
 

@@ -14,6 +14,18 @@ void AddTimings(const std::vector<StageTiming>& timings,
   }
 }
 
+v1::PlanCertainty CertaintyToProto(PlanCertainty certainty) {
+  switch (certainty) {
+    case PlanCertainty::kSure:
+      return v1::PLAN_CERTAINTY_SURE;
+    case PlanCertainty::kSimulated:
+      return v1::PLAN_CERTAINTY_SIMULATED;
+    case PlanCertainty::kUnsure:
+      return v1::PLAN_CERTAINTY_UNSURE;
+  }
+  return v1::PLAN_CERTAINTY_UNSPECIFIED;
+}
+
 v1::PickPlan PickPlanToProto(const PickPlan& plan) {
   v1::PickPlan p;
   p.set_tube_id(plan.tube_id);
@@ -28,6 +40,7 @@ v1::PickPlan PickPlanToProto(const PickPlan& plan) {
   p.mutable_cost()->set_total(plan.costs.total);
   p.set_simulated_displacement(plan.displacement.value_or(0.0));
   if (plan.X_BinTcp_place) *p.mutable_place_tcp_pose() = ToProto(*plan.X_BinTcp_place);
+  p.set_certainty(CertaintyToProto(plan.certainty));
   return p;
 }
 
@@ -45,6 +58,7 @@ v1::PlanningCounts CountsToProto(const PlanningCounts& c) {
   pc.set_rejected_workspace(c.rejected_workspace);
   pc.set_rejected_tool(c.rejected_tool);
   pc.set_rejected_fingers(c.rejected_fingers);
+  pc.set_non_occluded_lain_on(c.non_occluded_lain_on);
   return pc;
 }
 

@@ -31,6 +31,7 @@ void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan) {
                     {"trajectory", plan.cost().trajectory()},
                     {"total", plan.cost().total()}};
   record["simulated_displacement"] = plan.simulated_displacement();
+  record["certainty"] = CertaintyName(plan.certainty());
 }
 
 nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& check,

@@ -256,7 +256,25 @@ void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices
   Eigen::Isometry3d X_BinTcpAbovePlace = X_BinTcpPlace;
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
   TransitTo(X_BinTcpAbovePlace, &attempt, [&] { CheckStillHolding("place_transit", attempt); });
-  CheckLoadBeforePlace(reference, attempt);
+  v1::AnalyzeWrenchResponse check;
+  if (!LoadBeforePlace(reference, "before_place", attempt, &check)) {
+    // Light while the fingers still hold something: resting on the place surface, or lost.
+    CheckStillHolding("place_transit", attempt);
+    if (params_.place_recheck_height > 0.0) {
+      X_BinTcpAbovePlace.translation().z() += params_.place_recheck_height;
+      MoveTo(X_BinTcpAbovePlace, params_.approach_speed, &attempt);
+    }
+    if (params_.place_recheck_height == 0.0 ||
+        !LoadBeforePlace(reference, "before_place_recheck", attempt, &check)) {
+      throw TubeLost("place_transit", "wrench",
+                     fmt::format("the load above the place pose weighs {:.2f} N more than the empty gripper "
+                                 "(one tube: {:.2f} N){}",
+                                 check.held_weight(), check.tube_weight(),
+                                 params_.place_recheck_height > 0.0
+                                     ? fmt::format(", also {:.2f} m higher", params_.place_recheck_height)
+                                     : ""));
+    }
+  }
   MoveTo(X_BinTcpPlace, params_.approach_speed, &attempt);
   CheckStillHolding("place_descent", attempt);
   OpenGripper();
@@ -276,16 +294,12 @@ void CellController::CheckStillHolding(const char* where, Attempt& attempt) {
       fmt::format("the gripper no longer reports an object (fingers at {:.1f} mm)", status.opening * 1e3));
 }
 
-void CellController::CheckLoadBeforePlace(const devices::WrenchReading& reference, Attempt& attempt) {
+bool CellController::LoadBeforePlace(const devices::WrenchReading& reference, const char* key,
+                                     Attempt& attempt, v1::AnalyzeWrenchResponse* check) {
   const devices::WrenchReading above = ReadWrench();
-  const v1::AnalyzeWrenchResponse check =
-      LocalAnalyzeWrench(WrenchRequest(reference, above, CurrentPose()), params_.profile);
-  attempt.record["wrench"]["before_place"] = WrenchJson(above);
-  if (check.outcome() != v1::HELD_OUTCOME_NONE) return;
-  throw TubeLost("place_transit", "wrench",
-                 fmt::format("the load above the place pose weighs {:.2f} N more than the empty gripper "
-                             "(one tube: {:.2f} N)",
-                             check.held_weight(), check.tube_weight()));
+  *check = LocalAnalyzeWrench(WrenchRequest(reference, above, CurrentPose()), params_.profile);
+  attempt.record["wrench"][key] = WrenchJson(above);
+  return check->outcome() != v1::HELD_OUTCOME_NONE;
 }
 
 void CellController::RecordLost(const TubeLost& lost, Attempt& attempt) {

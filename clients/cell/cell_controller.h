@@ -365,7 +365,10 @@ class CellController {
   /// The gripper still reports the object (Robotiq gOBJ 2); throws TubeLost naming `where` if not.
   void CheckStillHolding(const char* where, Attempt& attempt);
   /// The load at the pose above the place pose still weighs a tube; throws TubeLost if not.
-  void CheckLoadBeforePlace(const devices::WrenchReading& reference, Attempt& attempt);
+  /// Reads the load above the place pose into record["wrench"][key]; false when it is lighter than
+  /// a tube.
+  bool LoadBeforePlace(const devices::WrenchReading& reference, const char* key, Attempt& attempt,
+                       v1::AnalyzeWrenchResponse* check);
   /// The tube is gone: record where and when, open (the fingers closed on nothing), home.
   void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);

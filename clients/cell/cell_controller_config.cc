@@ -96,6 +96,7 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
+  v("place_recheck_height", p.place_recheck_height, "m higher again when the load there is light");
   v("safe_release_height", p.safe_release_height,
     "m above the bin floor: a safe stop holding a tube opens there, over the bin's middle");
   v.OptionalPose("home_pose_in_bin", p.X_BinHome,

@@ -53,6 +53,7 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
+  RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
   RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
     throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");

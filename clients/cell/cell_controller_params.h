@@ -45,6 +45,11 @@ struct CellControllerParams {
   double safe_release_height = 0.15;
   /// The place pose is approached from this far above it, metres.
   double place_approach_height = 0.10;
+  /// The load above the place pose weighs less than a tube while the gripper still holds: the tube
+  /// may rest on the place surface (a modeled tube that missed a branch is placed lower than it
+  /// hangs). The TCP then rises this much more and reads again; only a load still missing there is
+  /// a lost tube. 0 = no second reading. Metres.
+  double place_recheck_height = 0.20;
   /// Where the robot waits while the bin is scanned (out of the scanner's view). Absent: above the
   /// cell's placement frame at transit height, TCP pointing down.
   std::optional<Eigen::Isometry3d> X_BinHome;

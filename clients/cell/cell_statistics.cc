@@ -121,7 +121,22 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
         ++sim.uses;
         if (picked) ++sim.successes;
       }
-      if (r.contains("resolution") && r["resolution"].value("used", 0) > 0) {
+      const bool resolved = r.contains("resolution") && r["resolution"].value("used", 0) > 0;
+      const bool worked = picked && !resolved;
+      const bool simulated = r.value("used_simulation", false);
+      // Records before plans carried a certainty: an unsimulated upward plan was a free pick.
+      const std::string certainty = r.value("certainty", std::string(simulated ? "simulated"
+                                                                     : escape  ? "unsure"
+                                                                               : "sure"));
+      const auto count = [worked](UseCount& u) {
+        ++u.uses;
+        if (worked) ++u.successes;
+      };
+      if (certainty == "sure") count(s.free_pick);
+      if (certainty == "unsure") count(s.needed_luck);
+      if (escape) count(s.escape_path);
+      if (simulated) count(s.simulated_path);
+      if (resolved) {
         ++c.resolution;
         ++s.resolution.uses;
         if (r["resolution"].value("succeeded", false)) ++s.resolution.successes;
@@ -190,6 +205,12 @@ json StatisticsJson(const CellStatistics& s) {
           {"upward", use(s.upward)},
           {"escape", use(s.escape)},
           {"resolution", use(s.resolution)},
+          {"paths",
+           {{"free_pick", use(s.free_pick)},
+            {"needed_luck", use(s.needed_luck)},
+            {"escape", use(s.escape_path)},
+            {"simulated", use(s.simulated_path)},
+            {"resolution", use(s.resolution)}}},
           {"nudges", use(s.nudges)},
           {"time_per_pick",
            {{"planning", times(s.times.planning)},

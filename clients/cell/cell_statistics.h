@@ -79,6 +79,11 @@ struct CellStatistics {
   UseCount upward, escape;
   /// Table 5.9: attempts that used the resolution rotation and those it turned into a pick.
   UseCount resolution;
+  /// Which path each attempt's plan took, and how often it worked: picked one tube with no
+  /// resolution rotation. A free pick is a sure plan (a non-occluded tube nothing lies on, lifted
+  /// straight up); a plan that needed luck is an unsure one (not simulated: occluded, or lain on);
+  /// escape and simulated count every escape trajectory and every simulated plan.
+  UseCount free_pick, needed_luck, escape_path, simulated_path;
   /// Nudges (result "nudge", or a fault during one), and those followed by a pick in the same
   /// round before the next nudge or scan without a plan.
   UseCount nudges;

@@ -172,7 +172,7 @@ struct SimCellParams {
   /// Material properties; nullopt = SimMaterialParams::Defaults(material).
   std::optional<SimMaterialParams> material_params;
   /// Tube shapes (Algorithm 2); nullopt = set A (pvc) or set B (rubber) with cell.tube's radius and
-  /// length. Only linear tubes (one branch).
+  /// length. Branched shapes (set C) with pvc only: each tree is one rigid body.
   std::optional<physics::RandomTubeParams> tube_shape;
   /// The place zone: a table or conveyor beside the bin, centred under cell.place.X_BinPlace's
   /// origin, this size along x_Bin and y_Bin, metres. Tubes at rest in it count as placed. The

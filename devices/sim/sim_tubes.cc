@@ -105,6 +105,25 @@ std::unique_ptr<btGeneric6DofSpring2Constraint> MakeJoint(btRigidBody& a, btRigi
   return joint;
 }
 
+/// A branched pvc tube: one rigid compound of its whole tree; its geometry kept in the body frame.
+SimTube AddRigidTree(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin,
+                     std::size_t tube_index, const TubeBodyOptions& options, SimTube tube) {
+  if (options.rubber) {
+    throw InvalidArgument(
+        "sim cell: tube " + std::to_string(tube_Bin.id) +
+        " is branched; the simulated cell makes branched tubes of pvc (one rigid body) only, "
+        "not rubber hose chains");
+  }
+  const BodyShape shape = CompoundShape(world, physics::MakeTubeSegments(tube_Bin.ToTube(), 0.001),
+                                        options.mass, options.collision_margin);
+  SimLink link;
+  link.mass = options.mass;
+  link.body = AddBody(world, shape, options.mass, options, tube_index, 0);
+  tube.links.push_back(std::move(link));
+  tube.tree_C = tube_Bin.Transformed(shape.X_BinC.inverse());
+  return tube;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> ResamplePolyline(const std::vector<Eigen::Vector3d>& line, int count) {
@@ -130,14 +149,15 @@ std::vector<Eigen::Vector3d> ResamplePolyline(const std::vector<Eigen::Vector3d>
 
 SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin, std::size_t tube_index,
                    const TubeBodyOptions& options) {
-  const std::vector<Eigen::Vector3d> line = tube_Bin.Centreline();  // throws when not linear
-  const double length = tube_Bin.Length();
+  const double length = tube_Bin.edges.empty() ? 0.0 : tube_Bin.Length();
   if (!(length > 0.0))
     throw InvalidArgument("sim cell: tube " + std::to_string(tube_Bin.id) + " has no length");
   SimTube tube;
   tube.id = tube_Bin.id;
   tube.radius = tube_Bin.edges.front().radius;
   tube.mass = options.mass;
+  if (!tube_Bin.IsLinear()) return AddRigidTree(world, tube_Bin, tube_index, options, std::move(tube));
+  const std::vector<Eigen::Vector3d> line = tube_Bin.Centreline();
 
   if (!options.rubber) {
     const BodyShape shape = CompoundShape(world, physics::MakeTubeSegments(tube_Bin.ToTube(), 0.001),
@@ -192,6 +212,7 @@ SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tub
 }
 
 physics::TubeGeometry CurrentGeometry(const SimTube& tube) {
+  if (tube.tree_C) return tube.tree_C->Transformed(FromBt(tube.links.front().body->getWorldTransform()));
   std::vector<Eigen::Vector3d> points;
   for (std::size_t l = 0; l < tube.links.size(); ++l) {
     const SimLink& link = tube.links[l];

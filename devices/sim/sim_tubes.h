@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <btBulletDynamicsCommon.h>
@@ -33,6 +34,8 @@ struct SimTube {
   double mass = 0.0;
   std::vector<SimLink> links;
   std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> joints;
+  /// A branched (pvc) tube: its tree in the frame C of its one body.
+  std::optional<physics::TubeGeometry> tree_C;
 };
 
 /// How tube bodies are made.
@@ -53,17 +56,19 @@ struct TubeBodyOptions {
   double time_step = 1.0 / 480.0;
 };
 
-/// Adds `tube_Bin` (linear; bin frame) to `world` where it is: one rigid capsule compound (pvc,
+/// Adds `tube_Bin` (bin frame) to `world` where it is: one rigid capsule compound (pvc, linear or
+/// branched,
 /// physics::MakeTubeShape) or a chain of capsule links joined at the centreline by
 /// btGeneric6DofSpring2Constraints (rubber: locked translation and twist, implicit angular springs
 /// about both bending axes whose rest angle is the generated shape).
 /// Links within two of each other do not collide. Every body's user index is `tube_index` and user
 /// index 2 its link index.
-/// @throws InvalidArgument when the tube is not linear or has no length.
+/// @throws InvalidArgument when the tube has no length, or is branched and rubber.
 SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin, std::size_t tube_index,
                    const TubeBodyOptions& options);
 
-/// The tube as it is now, bin frame: its centreline points as nodes (ids 1..n, in order; a joint
+/// The tube as it is now, bin frame: a branched tube's tree moved with its body; a linear tube's
+/// centreline points as nodes (ids 1..n, in order; a joint
 /// shared by two links is the mean of both), an edge between consecutive nodes ("e_<i>_<i+1>",
 /// order i, the tube's radius).
 physics::TubeGeometry CurrentGeometry(const SimTube& tube);

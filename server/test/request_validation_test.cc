@@ -239,6 +239,26 @@ TEST(ValidatePlanPick, AbsentFieldsTakeTheServerDefaults) {
   EXPECT_EQ(ValidatePlanPick(request, defaults).unit, LengthUnit::kMillimetre);
 }
 
+TEST(ValidatePlanPick, TubeTopologyComesFromTheCellOrTheServer) {
+  PlanningDefaults defaults;
+  defaults.cell.tube.topology = TubeTopology::kAuto;
+  v1::PlanPickRequest request = ValidRequest();
+  // Unspecified: the server's configured topology, even when the request carries a cell.
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.topology, TubeTopology::kAuto);
+  request.mutable_cell()->set_tube_topology(v1::TUBE_TOPOLOGY_BRANCHED);
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.topology, TubeTopology::kBranched);
+  request.mutable_cell()->set_tube_topology(v1::TUBE_TOPOLOGY_LINEAR);
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.topology, TubeTopology::kLinear);
+  // A number the enum does not define (proto3 enums are open) is refused, naming the field.
+  request.mutable_cell()->set_tube_topology(static_cast<v1::TubeTopology>(9));
+  try {
+    (void)ValidatePlanPick(request, defaults);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("cell.tube_topology: unknown value 9"));
+  }
+}
+
 TEST(ValidatePlanPick, NearlyUnitQuaternionIsNormalised) {
   v1::PlanPickRequest request = ValidRequest();
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));

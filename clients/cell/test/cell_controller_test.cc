@@ -851,7 +851,37 @@ TEST_F(PlaceFaultTest, NoLoadAboveThePlaceIsALostTubeEvenWhenTheGripperSaysHoldi
   EXPECT_EQ(a["result"], "lost");
   EXPECT_EQ(a["lost"]["detected_by"], "wrench");
   EXPECT_NEAR(a["wrench"]["before_place"]["force"][2].get<double>(), 0.11, 1e-12);
+  // Read again 0.2 m higher (place_recheck_height) before calling it lost.
+  EXPECT_TRUE(robot.Visited(DownPose(testing::PlacePose().translation() + Eigen::Vector3d(0, 0, 0.3))));
+  EXPECT_NEAR(a["wrench"]["before_place_recheck"]["force"][2].get<double>(), 0.11, 1e-12);
+  EXPECT_NE(a["lost"]["detail"].get<std::string>().find("also 0.20 m higher"), std::string::npos);
   EXPECT_FALSE(robot.Visited(testing::PlacePose()));
+}
+
+TEST_F(PlaceFaultTest, ATubeRestingOnThePlaceSurfaceIsCheckedHigherAndPlaced) {
+  // Above the place the tube weighs 0.15 of its 0.54 N (a branch on the table); 0.2 m higher, all.
+  ft.readings = {Reading(0.10), Reading(0.64), Reading(0.25), Reading(0.64)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_EQ(result.lost, 0u);
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "picked");
+  EXPECT_NEAR(a["wrench"]["before_place"]["force"][2].get<double>(), 0.25, 1e-12);
+  EXPECT_NEAR(a["wrench"]["before_place_recheck"]["force"][2].get<double>(), 0.64, 1e-12);
+  EXPECT_TRUE(robot.Visited(DownPose(testing::PlacePose().translation() + Eigen::Vector3d(0, 0, 0.3))));
+  ASSERT_EQ(gripper.opened_at.size(), 2u);  // the start's, then on the place pose
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(testing::PlacePose().translation(), kTol));
+}
+
+TEST_F(PlaceFaultTest, WithoutTheRecheckALightLoadAboveThePlaceIsALostTube) {
+  params.place_recheck_height = 0.0;
+  ft.readings = {Reading(0.10), Reading(0.64), Reading(0.25), Reading(0.64)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.lost, 1u) << result.message;
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "lost");
+  EXPECT_FALSE(a["wrench"].contains("before_place_recheck"));
+  EXPECT_EQ(a["lost"]["detail"].get<std::string>().find("higher"), std::string::npos);
 }
 
 TEST_F(CellControllerTest, RealClientWithNoServerWaitsItsBudgetThenSafeStops) {

@@ -153,3 +153,36 @@ TEST(CellStatisticsTest, NudgesCountWhenAPickFollowsBeforeTheNextScanWithoutPlan
 
 }  // namespace
 }  // namespace tubepick::cell
+
+namespace tubepick::cell {
+namespace {
+
+TEST(CellStatisticsTest, PathsCountWhatEachAttemptNeededAndWhetherItWorked) {
+  json sure = Attempt(0, 4, 3, "picked");
+  sure["certainty"] = "sure";
+  json lucky = Attempt(0, 3, 3, "multiple_returned", "upward", false, 1, false);
+  lucky["certainty"] = "unsure";
+  json escape = Attempt(0, 3, 2, "picked", "escape", true);
+  escape["certainty"] = "simulated";
+  json resolved = Attempt(0, 2, 1, "picked", "upward", true, 1, true);
+  resolved["certainty"] = "simulated";
+  json old_record = Attempt(0, 1, 0, "picked");  // written before plans carried a certainty
+  const CellStatistics s =
+      SummarizeRecords({sure, lucky, escape, resolved, old_record, End(0, "bin_empty", 4, 0)});
+  EXPECT_EQ(s.free_pick.uses, 2u);  // the sure plan and the old unsimulated upward one
+  EXPECT_EQ(s.free_pick.successes, 2u);
+  EXPECT_EQ(s.needed_luck.uses, 1u);
+  EXPECT_EQ(s.needed_luck.successes, 0u);
+  EXPECT_EQ(s.escape_path.uses, 1u);
+  EXPECT_EQ(s.escape_path.successes, 1u);
+  EXPECT_EQ(s.simulated_path.uses, 2u);
+  EXPECT_EQ(s.simulated_path.successes, 1u);  // the resolved pick needed the rotation: not worked
+  EXPECT_EQ(s.resolution.uses, 2u);
+  EXPECT_EQ(s.resolution.successes, 1u);
+  const json paths = StatisticsJson(s)["paths"];
+  EXPECT_EQ(paths["free_pick"]["uses"], 2);
+  EXPECT_EQ(paths["simulated"]["successes"], 1);
+}
+
+}  // namespace
+}  // namespace tubepick::cell

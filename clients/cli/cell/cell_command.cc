@@ -25,6 +25,7 @@
 #include "clients/cli/cell/planner_outage.h"
 #include "clients/cli/cell/round_view.h"
 #include "clients/cli/cell/sim_round.h"
+#include "clients/cli/inputs/sim_scene.h"
 #include "clients/cli/remote/server_process.h"
 #include "core/common/cell_config.h"
 #include "core/common/errors.h"
@@ -36,11 +37,29 @@ namespace {
 
 using nlohmann::json;
 
+/// --shapes: the bins' tubes follow this set's shapes (Algorithm 2 presets) with the cell's tube
+/// radius. A linear set keeps the cell's tube length; set C's trees are 0.75 m of tube (the cell's
+/// length, mass scaled with it, and topology branched, so that the planner joins junctions).
+void WithShapes(const std::string& set, devices::sim::SimCellParams* p) {
+  physics::RandomTubeParams shape = physics::RandomTubeParams::Preset(set);
+  shape.radius = p->cell.tube.radius;
+  if (shape.branches.size() == 1) {
+    if (p->cell.tube.length > 0.0) shape.branches.front().length = p->cell.tube.length;
+  } else {
+    const CellConfig tree = CellForPreset(p->cell, set);
+    if (p->cell.tube.length > 0.0) p->cell.tube.mass *= tree.tube.length / p->cell.tube.length;
+    p->cell.tube.length = tree.tube.length;
+    p->cell.tube.topology = tree.tube.topology;
+  }
+  p->tube_shape = shape;
+}
+
 struct CellOptions {
   bool sim = false;
   std::uint32_t rounds = 1;
   std::uint32_t tubes = 7;
   std::string material = "pvc";
+  std::string shapes;  ///< --shapes: A, B or C; empty = the material's thesis set (pvc A, rubber B)
   std::string server = "auto";
   std::uint64_t seed = 1;
   std::string records_path;
@@ -256,13 +275,15 @@ void Run(const CellOptions& o) {
   if (o.server == "auto" &&
       !(tls.tls_ca_file.empty() && tls.tls_cert_file.empty() && tls.tls_server_name.empty()))
     throw InvalidArgument(
-        "--tls-*: the planner --server auto starts is plaintext on loopback; give the TLS planner's --server "
+        "--tls-*: the planner --server auto starts is plaintext on loopback; give the TLS planner's "
+        "--server "
         "HOST:PORT");
   if (o.sim && !o.devices_path.empty())
     throw InvalidArgument("--sim and --devices: give one (--sim is the all-simulated cell)");
   if (!o.sim && o.devices_path.empty())
     throw InvalidArgument(
-        "which cell? --devices FILE for a real cell (tubepick cell --print-devices-config prints an example; "
+        "which cell? --devices FILE for a real cell (tubepick cell --print-devices-config prints an "
+        "example; "
         "`tubepick devices check --devices FILE` first), or --sim for the simulated cell");
   if (!o.devices_path.empty()) return RunOnDevices(o, base_params);
   if (o.dry_run)
@@ -297,6 +318,7 @@ void Run(const CellOptions& o) {
     devices::sim::SimCellParams sim_params =
         devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
     if (custom_cell) sim_params.cell = cell_config;
+    if (!o.shapes.empty()) WithShapes(o.shapes, &sim_params);
     if (server) {
       server->AwaitBack();
       server->StartAgain();  // an outage the last round ended in
@@ -315,7 +337,8 @@ void Run(const CellOptions& o) {
     const std::uint32_t left = r.tubes_in_bin;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     fmt::print(
-        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released outside, "
+        "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released "
+        "outside, "
         "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         result.attempts, result.scans, r.simulated_s, wall);
@@ -344,6 +367,7 @@ void Run(const CellOptions& o) {
   records.PrintPages();
   if (injecting) fmt::print("{}\n{}\n", campaign.KindsLine(), campaign.SummaryLine());
   WriteJson(o.json_path, json{{"material", o.material},
+                              {"shapes", o.shapes.empty() ? (o.material == "rubber" ? "B" : "A") : o.shapes},
                               {"tubes", o.tubes},
                               {"seed", o.seed},
                               {"rounds", rounds_json},
@@ -386,6 +410,11 @@ void AddCellCommand(CLI::App& app) {
   cmd->add_option("--tubes", o->tubes, "Tubes dropped into the bin per round")->capture_default_str();
   cmd->add_option("--material", o->material, "pvc (set A) or rubber (set B), thesis Table 5.2")
       ->capture_default_str();
+  cmd->add_option(
+         "--shapes", o->shapes,
+         "Tube shapes of the simulated bins: A (20° bends), B (45°) or C (branched trees, pvc only); "
+         "default: A for pvc, B for rubber")
+      ->check(CLI::IsMember({"A", "B", "C"}));
   cmd->add_option("--server", o->server,
                   "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
       ->capture_default_str();

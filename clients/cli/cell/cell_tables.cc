@@ -108,6 +108,18 @@ std::string FormatCellTables(const CellStatistics& s, const std::string& title) 
   out += use_line("success rate", s.resolution);
   out += "\n";
 
+  out += "Paths: how often each was needed, and how often it worked (one tube picked, no resolution)\n";
+  const auto path_line = [](const std::string& label, const cell::UseCount& u) {
+    return fmt::format("  {:<34}{:>5} attempts{:>9} worked\n", label, u.uses, Percent(u.successes, u.uses));
+  };
+  out += path_line("free pick (sure plan)", s.free_pick);
+  out += path_line("plan that needed luck (unsure)", s.needed_luck);
+  out += path_line("escape trajectory", s.escape_path);
+  out += path_line("simulated choice", s.simulated_path);
+  out += fmt::format("  {:<34}{:>5} attempts{:>9} freed one tube\n", "resolution rotation", s.resolution.uses,
+                     Percent(s.resolution.successes, s.resolution.uses));
+  out += "\n";
+
   out += "Nudges: a tube along a wall dragged off it when no plan was executable (beyond the thesis)\n";
   out += fmt::format("  {:<34}{:>7}\n", "nudges", s.nudges.uses);
   out += use_line("followed by a pick", s.nudges);

@@ -75,6 +75,43 @@ TEST(SimCell, ConstructionDropsEveryTubeIntoTheBin) {
   }
 }
 
+TEST(SimCell, BranchedPvcTreesAreRigidBodiesThatKeepTheirShape) {
+  SimCellParams params = SimCellParams::Thesis(Material::kPvc, 3, 5);
+  params.tube_shape = physics::RandomTubeParams::SetC();
+  params.tube_shape->radius = params.cell.tube.radius;
+  SimCell cell(params);
+  EXPECT_EQ(cell.TubesInBin(), 3u);
+  const std::vector<physics::TubeGeometry> before = cell.TubesBin();
+  ASSERT_EQ(before.size(), 3u);
+  for (const physics::TubeGeometry& tree : before) {
+    EXPECT_FALSE(tree.IsLinear());
+    const Tube core = tree.ToTube();
+    EXPECT_TRUE(core.branched());
+    EXPECT_NEAR(core.length(), 0.75, 0.02);  // trunk 30 cm, branches 10 + 10 + 15 + 10 cm
+  }
+  // A scan moves nothing but time: every tree keeps its edge lengths (one rigid body each).
+  (void)cell.scanner().Scan(kLong);
+  const std::vector<physics::TubeGeometry> after = cell.TubesBin();
+  for (std::size_t t = 0; t < before.size(); ++t) {
+    ASSERT_EQ(after[t].edges.size(), before[t].edges.size());
+    for (std::size_t e = 0; e < before[t].edges.size(); ++e) {
+      const auto span = [](const physics::TubeGeometry& g, const physics::TubeEdge& edge) {
+        return (g.Node(edge.node2).centre - g.Node(edge.node1).centre).norm();
+      };
+      EXPECT_NEAR(span(after[t], after[t].edges[e]), span(before[t], before[t].edges[e]), 1e-9);
+    }
+  }
+
+  // Rubber trees are refused, naming what is missing.
+  params.material = Material::kRubber;
+  try {
+    SimCell rubber(params);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("branched tubes of pvc (one rigid body) only"));
+  }
+}
+
 TEST(SimCell, IsolatedTubeLiftReadsItsWeightAndPlacesOutside) {
   SimCellParams params;
   params.seed = 4;
