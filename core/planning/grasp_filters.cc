@@ -151,6 +151,10 @@ bool InsideWorkspace(const Grasp& grasp, const Trajectory& trajectory, const Gra
 }
 
 bool InAllowedSection(const Grasp& grasp, const Trajectory& trajectory) {
+  if (!trajectory.section_mask.empty()) {
+    return grasp.cylinder_index < trajectory.section_mask.size() &&
+           trajectory.section_mask[grasp.cylinder_index];
+  }
   return grasp.cylinder_index >= trajectory.section_begin && grasp.cylinder_index < trajectory.section_end;
 }
 

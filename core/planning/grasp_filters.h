@@ -89,7 +89,8 @@ bool FingersCollide(const Grasp& grasp, const RawCloudIndex& raw, const GraspFil
 /// Filter (b): the grasp point plus every waypoint lies inside the workspace box (inclusive).
 bool InsideWorkspace(const Grasp& grasp, const Trajectory& trajectory, const GraspFilterParams& params);
 
-/// Filter (c): the grasp's cylinder is in [section_begin, section_end) of the trajectory.
+/// Filter (c): the grasp's cylinder is in [section_begin, section_end) of the trajectory, or, when
+/// the trajectory has a section_mask (a branched tube's escape), marked in it.
 bool InAllowedSection(const Grasp& grasp, const Trajectory& trajectory);
 
 }  // namespace tubepick

@@ -35,6 +35,9 @@ struct Trajectory {
   Eigen::Vector3d escape_direction = Eigen::Vector3d::Zero();
   std::uint32_t section_begin = 0;
   std::uint32_t section_end = 0;
+  /// Escapes of a branched tube, whose sections are subtrees rather than index ranges: when not
+  /// empty, cylinder i may hold the grasp iff section_mask[i] (instead of the range above).
+  std::vector<std::uint8_t> section_mask;
 };
 
 /// What simulating one trajectory measured (thesis §5.2.3.2).

@@ -113,6 +113,77 @@ std::optional<std::array<EscapeCandidate, 2>> EscapeCandidates(const Tube& tube,
   return out;
 }
 
+std::vector<std::uint8_t> SideOfJointA(const Tube& tube, std::uint32_t joint) {
+  const std::vector<TubeJoint> joints = TubeJoints(tube);
+  const std::vector<TubeBranch> branches = BranchesOf(tube);
+  assert(joint < joints.size());
+  // Vertices: cylinders 0..n−1, then nodes n..n+m−1; joined by every joint but `joint`, and by
+  // the branch ends that start or end on their node without a link.
+  const std::size_t n = tube.cylinders.size();
+  std::vector<std::size_t> parent(n + NodesOf(tube).size());
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  const auto find = [&parent](std::size_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  const auto vertex = [&](std::int32_t cylinder, const TubeJoint& j, bool at_a) -> std::size_t {
+    if (cylinder >= 0) return static_cast<std::size_t>(cylinder);
+    const TubeBranch& b = branches[j.branch];
+    return n + (at_a ? b.from_node : b.to_node);
+  };
+  std::vector<bool> linked_start(branches.size(), false), linked_end(branches.size(), false);
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const TubeJoint& j = joints[k];
+    if (j.cylinder_a < 0) linked_start[j.branch] = true;
+    if (j.cylinder_b < 0) linked_end[j.branch] = true;
+    if (k != joint) parent[find(vertex(j.cylinder_a, j, true))] = find(vertex(j.cylinder_b, j, false));
+  }
+  for (std::size_t b = 0; b < branches.size(); ++b) {
+    const TubeBranch& br = branches[b];
+    if (br.cylinder_count == 0) continue;
+    if (!linked_start[b]) parent[find(br.first_cylinder)] = find(n + br.from_node);
+    if (!linked_end[b]) parent[find(br.first_cylinder + br.cylinder_count - 1)] = find(n + br.to_node);
+  }
+  const std::size_t side_a = find(vertex(joints[joint].cylinder_a, joints[joint], true));
+  std::vector<std::uint8_t> mask(n, 0);
+  for (std::size_t i = 0; i < n; ++i) mask[i] = find(i) == side_a ? 1 : 0;
+  return mask;
+}
+
+std::optional<std::array<TreeEscapeCandidate, 2>> TreeEscapeCandidates(const Tube& tube, std::uint32_t joint,
+                                                                       double constant_distance,
+                                                                       const SafetyZone& zone) {
+  const TubeJoint j = TubeJoints(tube).at(joint);
+  const Eigen::Vector3d line = Xy(j.b - j.a);
+  if (line.norm() < kMinEscapeLineXy) return std::nullopt;
+  const Eigen::Vector3d u = line.normalized();
+  const std::vector<std::uint8_t> side_a = SideOfJointA(tube, joint);
+  std::array<TreeEscapeCandidate, 2> out;
+  for (int i = 0; i < 2; ++i) {
+    const bool towards_b = i == 0;  // the a side trails
+    EscapeCandidate& e = out[i].escape;
+    e.joint = joint;
+    e.towards_end = towards_b;
+    e.direction = towards_b ? u : Eigen::Vector3d(-u);
+    const Eigen::Vector3d& occl = towards_b ? j.a : j.b;
+    double farthest = 0.0;
+    out[i].leading_mask.assign(tube.cylinders.size(), 0);
+    for (std::size_t c = 0; c < tube.cylinders.size(); ++c) {
+      const bool trailing = (side_a[c] != 0) == towards_b;
+      out[i].leading_mask[c] = trailing ? 0 : 1;
+      if (!trailing) continue;
+      farthest = std::max({farthest, std::abs(u.dot(tube.cylinders[c].start - occl)),
+                           std::abs(u.dot(tube.cylinders[c].end - occl))});
+    }
+    e.variable_distance = farthest;
+    e.constant_distance = constant_distance;
+    e.escape_distance = e.variable_distance + e.constant_distance;
+    e.zone_limit = SafetyZoneLimit(tube, e.direction, zone);
+    e.distance = std::max(0.0, std::min(e.escape_distance, e.zone_limit));
+  }
+  return out;
+}
+
 Trajectory UpwardTrajectory(std::uint32_t tube_index, const Tube& tube, const TrajectoryParams& params) {
   Trajectory t = MakeTrajectory(tube_index, TrajectoryKind::kUpward,
                                 CylinderRange{0, static_cast<std::uint32_t>(tube.cylinders.size())});
@@ -139,9 +210,21 @@ std::vector<Trajectory> SynthesizeTrajectories(std::uint32_t tube_index, const T
   out.push_back(UpwardTrajectory(tube_index, tube, params));
   const double d_const = params.escape_constant > 0.0 ? params.escape_constant : 3.0 * tube_radius;
   const auto n = static_cast<std::uint32_t>(tube.cylinders.size());
-  // Escapes move one section of a linear tube out from under its occluder; a branched tube's
-  // sections are subtrees, not cylinder ranges, so it is lifted straight up (and simulated).
-  if (BranchesOf(tube).size() > 1) return out;
+  if (BranchesOf(tube).size() > 1) {
+    // A tree: its sections are subtrees (cylinder masks). Weakly occluded: both escapes of the
+    // joint; strongly occluded trees are lifted straight up (and simulated).
+    if (cls.occlusion != Occlusion::kWeak) return out;
+    const auto candidates = TreeEscapeCandidates(tube, cls.occluded_joints.front(), d_const, zone);
+    if (!candidates) return out;
+    for (const TreeEscapeCandidate& c : *candidates) {
+      if (c.escape.distance < params.min_escape_distance) continue;
+      Trajectory t =
+          EscapeTrajectory(tube_index, c.escape, TrajectoryKind::kEscape, CylinderRange{0, n}, params);
+      t.section_mask = c.leading_mask;
+      out.push_back(std::move(t));
+    }
+    return out;
+  }
 
   if (cls.occlusion == Occlusion::kWeak) {
     assert(cls.occluded_joints.size() == 1);

@@ -97,6 +97,26 @@ std::optional<std::array<EscapeCandidate, 2>> EscapeCandidates(const Tube& tube,
                                                                double constant_distance,
                                                                const SafetyZone& zone);
 
+/// The two sides of joint `joint` (an index into TubeJoints(tube)) of a branched tube: per
+/// cylinder, 1 when it is on the joint's `a` side (the tree without that joint falls in two).
+/// @pre joint < TubeJoints(tube).size(); the tube is a tree (ValidateTubeGraph)
+std::vector<std::uint8_t> SideOfJointA(const Tube& tube, std::uint32_t joint);
+
+/// A branched tube's escape over joint `joint` (Def. 5.2.6 on a tree): the escape line is the xy
+/// projection of the joint (from its `a` end to its `b` end); moving along +line drags the `a`
+/// side under the occluder (it trails) and the gripper holds the `b` side (it leads), and the other
+/// way round. d_var is the farthest projection of the trailing side's cylinder endpoints from the
+/// joint end on that side, as on a linear tube. nullopt when the joint's xy projection is shorter
+/// than 1 µm. [0] moves towards `b`, [1] towards `a`; `trailing`/`leading` are left empty (the
+/// sides are the masks in `leading_mask`).
+struct TreeEscapeCandidate {
+  EscapeCandidate escape;
+  std::vector<std::uint8_t> leading_mask;
+};
+std::optional<std::array<TreeEscapeCandidate, 2>> TreeEscapeCandidates(const Tube& tube, std::uint32_t joint,
+                                                                       double constant_distance,
+                                                                       const SafetyZone& zone);
+
 /// Waypoints (0,0,0) → (0,0,h).
 Trajectory UpwardTrajectory(std::uint32_t tube_index, const Tube& tube, const TrajectoryParams& params);
 
@@ -117,6 +137,9 @@ Trajectory EscapeTrajectory(std::uint32_t tube_index, const EscapeCandidate& can
 ///   of motion (cylinders [last joint + 1, n) when moving towards the end, [0, first joint + 1)
 ///   towards the start): while the tube slides, every occluder moves backwards relative to the
 ///   tube, so a gripper held anywhere behind an occluder would run into it.
+/// A branched tube (several branches): upward; when WEAK also the two TreeEscapeCandidates of its
+/// occluded joint, grasps allowed on the leading subtree (Trajectory::section_mask); a STRONG
+/// tree is lifted straight up only.
 /// Escapes whose distance is below min_escape_distance, or whose escape line is degenerate,
 /// are dropped. `tube_radius` gives the default d_const (3·radius).
 /// @pre tube classified as `cls`; params validated.

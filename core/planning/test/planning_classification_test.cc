@@ -8,6 +8,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/tube_graph.h"
+#include "core/planning/grasp_filters.h"
 #include "core/planning/grasp_ranking.h"
 #include "core/planning/test/planning_test_util.h"
 #include "core/planning/trajectory_synthesis.h"
@@ -159,16 +160,54 @@ TEST(ClassificationOfBranchedTubes, AJunctionLinkIsOccludedOnlyWhenLongerThanARa
   EXPECT_EQ(result.classes[0].occlusion, Occlusion::kWeak);
 }
 
-TEST(ClassificationOfBranchedTubes, ABranchedTubeIsLiftedStraightUpOnly) {
+TEST(ClassificationOfBranchedTubes, AWeaklyOccludedTreeEscapesAlongItsOccludedJoint) {
+  // The tee's one occluded joint is the 5 cm link from the node (0.10, 0) to the branch along +y.
   const Tube tee = Tee(0.05);
   const ClassificationResult result = ClassifyTubes({tee}, 0.0, ClassificationParams{});
+  ASSERT_EQ(result.classes[0].occlusion, Occlusion::kWeak);
   SafetyZone zone;
   zone.min = Eigen::Vector2d(-0.4, -0.3);
   zone.max = Eigen::Vector2d(0.4, 0.3);
   const std::vector<Trajectory> trajectories =
       SynthesizeTrajectories(0, result.tubes[0], result.classes[0], 0.0125, zone, TrajectoryParams{});
-  ASSERT_EQ(trajectories.size(), 1u);
+  ASSERT_EQ(trajectories.size(), 3u);
   EXPECT_EQ(trajectories[0].kind, TrajectoryKind::kUpward);
+  EXPECT_TRUE(trajectories[0].section_mask.empty());
+  // Towards the branch (+y): the run trails under the occluder, the branch is held; the run lies
+  // on the escape line (d_var 0), so the move is d_const = 3 r.
+  const Trajectory& towards_branch = trajectories[1];
+  EXPECT_EQ(towards_branch.kind, TrajectoryKind::kEscape);
+  EXPECT_TRUE(towards_branch.escape_direction.isApprox(Eigen::Vector3d::UnitY(), 1e-12));
+  EXPECT_EQ(towards_branch.section_mask, (std::vector<std::uint8_t>{0, 0, 1}));
+  EXPECT_NEAR(towards_branch.waypoints[2].y(), 3.0 * 0.0125, 1e-12);
+  // Towards the run (−y): the 10 cm branch trails from 5 cm off the node: d_var 0.10 + 3 r.
+  const Trajectory& towards_run = trajectories[2];
+  EXPECT_TRUE(towards_run.escape_direction.isApprox(-Eigen::Vector3d::UnitY(), 1e-12));
+  EXPECT_EQ(towards_run.section_mask, (std::vector<std::uint8_t>{1, 1, 0}));
+  EXPECT_NEAR(towards_run.waypoints[2].y(), -(0.10 + 3.0 * 0.0125), 1e-12);
+  // The grasp filter follows the mask.
+  Grasp on_branch, on_run;
+  on_branch.cylinder_index = 2;
+  on_run.cylinder_index = 1;
+  EXPECT_TRUE(InAllowedSection(on_branch, towards_branch));
+  EXPECT_FALSE(InAllowedSection(on_run, towards_branch));
+  EXPECT_TRUE(InAllowedSection(on_run, towards_run));
+
+  // A strongly occluded tree is still lifted straight up only.
+  TubeClass strong = result.classes[0];
+  strong.occlusion = Occlusion::kStrong;
+  strong.occluded_joints = {0, 0};
+  EXPECT_EQ(SynthesizeTrajectories(0, result.tubes[0], strong, 0.0125, zone, TrajectoryParams{}).size(), 1u);
+}
+
+TEST(ClassificationOfBranchedTubes, TheSidesOfAJointAreTheTwoSubtrees) {
+  // The run's first cylinder stops 2 cm short of the node: joint 0 links it to the node; joint 1
+  // is the branch's link.
+  Tube tee = Tee(0.05);
+  tee.cylinders[0].end.x() = 0.08;
+  ASSERT_EQ(TubeJoints(tee).size(), 2u);
+  EXPECT_EQ(SideOfJointA(tee, 0), (std::vector<std::uint8_t>{1, 0, 0}));
+  EXPECT_EQ(SideOfJointA(tee, 1), (std::vector<std::uint8_t>{1, 1, 0}));
 }
 
 TEST(ClassificationOfBranchedTubes, GraspsNearTheWholeTubesMassCentreCostLess) {
