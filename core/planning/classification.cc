@@ -24,6 +24,20 @@ std::vector<std::uint32_t> OccludedJoints(const Tube& tube, const Classification
   return occluded;
 }
 
+std::string ToString(Occlusion occlusion) {
+  switch (occlusion) {
+    case Occlusion::kNone:
+      return "none";
+    case Occlusion::kWeak:
+      return "weak";
+    case Occlusion::kStrong:
+      return "strong";
+    case Occlusion::kUnspecified:
+      break;
+  }
+  return "unspecified";
+}
+
 Occlusion OcclusionOf(std::size_t occluded_joint_count) {
   if (occluded_joint_count == 0) return Occlusion::kNone;
   if (occluded_joint_count == 1) return Occlusion::kWeak;

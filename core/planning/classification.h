@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,9 @@ struct TubeClass {
 /// segments, and links to a junction node longer than the branch's radius plus
 /// params.junction_gap. Ascending indices into TubeJoints(tube).
 std::vector<std::uint32_t> OccludedJoints(const Tube& tube, const ClassificationParams& params = {});
+
+/// "none", "weak", "strong", "unspecified".
+std::string ToString(Occlusion occlusion);
 
 /// NONE for 0 occluded joints (Def. 5.2.2), WEAK for 1 (Def. 5.2.3), STRONG for 2+ (Def. 5.2.4).
 Occlusion OcclusionOf(std::size_t occluded_joint_count);

@@ -141,6 +141,12 @@ export function kindName(s) {
   return String(s || 'TRAJECTORY_KIND_UPWARD').replace(/^TRAJECTORY_KIND_/, '').toLowerCase().replace(/_/g, ' ');
 }
 
+/** "sure", "simulated", "unsure", or "–" for an answer without one (older servers). */
+export function certaintyName(s) {
+  const v = String(s || '').replace(/^PLAN_CERTAINTY_/, '').toLowerCase();
+  return ['sure', 'simulated', 'unsure'].includes(v) ? v : '–';
+}
+
 function normPlan(p, index) {
   const g = p.grasp || {};
   return {
@@ -148,7 +154,7 @@ function normPlan(p, index) {
     tcp: pose(g.tcpPose), approach: vec3(g.approach), openingWidth: num(g.openingWidth),
     waypoints: (p.waypoints || []).map(vec3), kind: kindName(p.trajectoryKind),
     cost: { H: num(p.cost?.height), C: num(p.cost?.centre), T: num(p.cost?.trajectory), G: num(p.cost?.total) },
-    displacement: num(p.simulatedDisplacement),
+    displacement: num(p.simulatedDisplacement), certainty: certaintyName(p.certainty),
     place: p.placeTcpPose ? pose(p.placeTcpPose) : null,
   };
 }

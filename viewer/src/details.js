@@ -58,6 +58,7 @@ export function planDetails(m, plan) {
     ['place TCP', plan.place ? xyz(plan.place.p, 'place') : '–'],
     ['cost', costs(plan.cost)],
     ['simulated displacement', el('b', { 'data-field': 'displacement' }, `${fmt(plan.displacement)} m`)],
+    ['certainty', el('b', { 'data-field': 'certainty', title: 'sure: a free tube nothing lies on, lifted straight up; simulated: its displacement says how safe; unsure: needed luck' }, plan.certainty)],
   ];
   return [header(m, plan), el('div', { class: 'pd-grid' }, rows.flatMap(([k, v]) => [el('div', { class: 'k' }, k), el('div', { class: 'v' }, v)]))];
 }

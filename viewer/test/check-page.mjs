@@ -59,6 +59,7 @@ function expectedFrames(data) {
     const plans = Array.isArray(f.plan?.plans) ? f.plan.plans : [];
     const grasp = (p) => ['x', 'y', 'z'].map((k) => num(p.grasp?.tcpPose?.position?.[k]));
     return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)), grasps: plans.map(grasp),
+      certainties: plans.map((p) => String(p.certainty || '').replace(/^PLAN_CERTAINTY_/, '').toLowerCase() || '–'),
       graphs: tubes.map(tubeGraph) };
   });
 }
@@ -141,6 +142,8 @@ async function checkPlanDetails(page, f, k) {
   const err = Math.max(...shown.map((t, i) => (t == null ? Infinity : Math.abs(Number(t) - want[i]))));
   check(err <= GRASP_TOL, `  plan ${k} details: grasp x/y/z`,
     `shown (${shown.join(', ')}) vs JSON (${want.map((v) => v.toFixed(4)).join(', ')}), max error ${Number.isFinite(err) ? err.toFixed(5) : 'missing'} m (≤ ${GRASP_TOL})`);
+  const certainty = await page.evaluate(() => document.querySelector('#plan-details [data-field="certainty"]')?.textContent ?? null);
+  check(certainty === f.certainties[k], `  plan ${k} details: certainty`, `shown "${certainty}" vs JSON "${f.certainties[k]}"`);
 }
 
 async function checkTubeClick(page, f, id) {

@@ -9,19 +9,6 @@
 namespace tubepick::cli {
 namespace {
 
-std::string ClassName(Occlusion occlusion) {
-  switch (occlusion) {
-    case Occlusion::kNone:
-      return "none";
-    case Occlusion::kWeak:
-      return "weak";
-    case Occlusion::kStrong:
-      return "strong";
-    default:
-      return "unspecified";
-  }
-}
-
 double DistanceToAxis(const Eigen::Vector3d& p, const Tube& tube) {
   double best = std::numeric_limits<double>::infinity();
   for (const AxisPiece& piece : TubeAxisPieces(tube))
@@ -50,7 +37,7 @@ PlanCheck CheckBestPlan(const PickPlanResult& plan, const std::vector<physics::T
   check.certainty = ToString(best.certainty);
   check.trajectory = ToString(best.kind);
   for (const Tube& t : plan.tubes) {
-    if (t.id == best.tube_id) check.modeled_class = ClassName(t.occlusion);
+    if (t.id == best.tube_id) check.modeled_class = ToString(t.occlusion);
   }
 
   double nearest = std::numeric_limits<double>::infinity();

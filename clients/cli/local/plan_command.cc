@@ -24,20 +24,6 @@ struct PlanOptions {
   std::uint32_t show = 5;
 };
 
-const char* OcclusionName(Occlusion o) {
-  switch (o) {
-    case Occlusion::kNone:
-      return "none";
-    case Occlusion::kWeak:
-      return "weak";
-    case Occlusion::kStrong:
-      return "strong";
-    case Occlusion::kUnspecified:
-      break;
-  }
-  return "-";
-}
-
 void Run(const PlanOptions& o) {
   const CommonOptions& common = o.input.common;
   const CellConfig cell = LoadCell(common);
@@ -57,7 +43,7 @@ void Run(const PlanOptions& o) {
     std::string lain_on;
     for (std::uint32_t u : plan.classes[i].lying_on) lain_on += fmt::format("{} ", plan.tubes[u].id);
     fmt::print("{:>5} {:>9.3f} {:>8} {:>9}  {}\n", t.id, t.length(), BranchesOf(t).size(),
-               OcclusionName(t.occlusion), lain_on.empty() ? "-" : lain_on);
+               ToString(t.occlusion), lain_on.empty() ? "-" : lain_on);
   }
   fmt::print("{:>4} {:>5} {:>17} {:>9} {:>26} {:>7} {:>7} {:>7} {:>7} {:>9}\n", "rank", "tube", "trajectory",
              "certainty", "grasp (x, y, z) m", "H", "C", "T", "G", "disp_m");
