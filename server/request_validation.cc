@@ -106,18 +106,8 @@ v1::PlanPickRequest AsPlanPick(const v1::ModelTubesRequest& request) {
 }
 
 TubeTopology TopologyOf(v1::TubeTopology topology, TubeTopology configured, const std::string& field) {
-  switch (topology) {
-    case v1::TUBE_TOPOLOGY_UNSPECIFIED:
-      return configured;
-    case v1::TUBE_TOPOLOGY_LINEAR:
-      return TubeTopology::kLinear;
-    case v1::TUBE_TOPOLOGY_BRANCHED:
-      return TubeTopology::kBranched;
-    case v1::TUBE_TOPOLOGY_AUTO:
-      return TubeTopology::kAuto;
-    default:
-      break;
-  }
+  if (topology == v1::TUBE_TOPOLOGY_UNSPECIFIED) return configured;
+  if (const std::optional<TubeTopology> known = FromProto(topology)) return *known;
   throw InvalidArgument(field + ": unknown value " + std::to_string(static_cast<int>(topology)) +
                         " (expected TUBE_TOPOLOGY_LINEAR, _BRANCHED or _AUTO)");
 }

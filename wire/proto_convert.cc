@@ -144,6 +144,31 @@ v1::ResolutionVariant ToProto(ResolutionVariant variant) {
   return v1::RESOLUTION_VARIANT_UNSPECIFIED;
 }
 
+v1::TubeTopology ToProto(TubeTopology topology) {
+  switch (topology) {
+    case TubeTopology::kLinear:
+      return v1::TUBE_TOPOLOGY_LINEAR;
+    case TubeTopology::kBranched:
+      return v1::TUBE_TOPOLOGY_BRANCHED;
+    case TubeTopology::kAuto:
+      return v1::TUBE_TOPOLOGY_AUTO;
+  }
+  return v1::TUBE_TOPOLOGY_UNSPECIFIED;
+}
+
+std::optional<TubeTopology> FromProto(v1::TubeTopology topology) {
+  switch (topology) {
+    case v1::TUBE_TOPOLOGY_LINEAR:
+      return TubeTopology::kLinear;
+    case v1::TUBE_TOPOLOGY_BRANCHED:
+      return TubeTopology::kBranched;
+    case v1::TUBE_TOPOLOGY_AUTO:
+      return TubeTopology::kAuto;
+    default:
+      return std::nullopt;
+  }
+}
+
 v1::ResolutionMotion ToProto(const ResolutionMotion& motion) {
   v1::ResolutionMotion out;
   *out.mutable_axis_tcp() = ToProto(motion.axis_Tcp);
@@ -196,9 +221,7 @@ v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isome
   out.set_tube_radius(cell.tube.radius);
   out.set_tube_length(cell.tube.length);
   out.set_tube_mass(cell.tube.mass);
-  out.set_tube_topology(cell.tube.topology == TubeTopology::kBranched ? v1::TUBE_TOPOLOGY_BRANCHED
-                        : cell.tube.topology == TubeTopology::kAuto   ? v1::TUBE_TOPOLOGY_AUTO
-                                                                      : v1::TUBE_TOPOLOGY_LINEAR);
+  out.set_tube_topology(ToProto(cell.tube.topology));
   *out.mutable_place_pose() = ToProto(cell.place.X_BinPlace);
   return out;
 }

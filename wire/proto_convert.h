@@ -46,6 +46,10 @@ Eigen::Isometry3d FromProto(const v1::Pose& pose, const std::string& field);
 /// The core variant of a wire value; std::nullopt for RESOLUTION_VARIANT_UNSPECIFIED and for
 /// numbers the enum does not define (proto3 enums are open).
 std::optional<ResolutionVariant> FromProto(v1::ResolutionVariant variant);
+/// The wire value of a cell's tube topology, and back: std::nullopt for TUBE_TOPOLOGY_UNSPECIFIED
+/// and for numbers the enum does not define.
+v1::TubeTopology ToProto(TubeTopology topology);
+std::optional<TubeTopology> FromProto(v1::TubeTopology topology);
 
 /// The CellDescription of `cell` with the sensor pose of the capture (X_BinSensor).
 v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isometry3d& X_BinSensor);

@@ -149,13 +149,14 @@ std::vector<bool> TrajectoriesToSimulate(const PlanningContext& ctx, Occlusion s
                                          const std::vector<Candidate>& viable, const PickPlanResult& result) {
   std::vector<bool> simulate(trajectories.size(), false);
   if (ctx.evaluator == nullptr) return simulate;
-  for (const Candidate& c : viable) simulate[c.trajectory] = true;
-  if (stage != Occlusion::kNone) return simulate;
-  if (!ctx.params.certainty.safe_first) return std::vector<bool>(trajectories.size(), false);
-  for (const Candidate& c : viable) {
-    if (result.classes[trajectories[c.trajectory].tube_index].lying_on.empty())
-      return std::vector<bool>(trajectories.size(), false);  // a sure plan exists
+  if (stage == Occlusion::kNone) {
+    if (!ctx.params.certainty.safe_first) return simulate;
+    for (const Candidate& c : viable) {
+      if (result.classes[trajectories[c.trajectory].tube_index].lying_on.empty())
+        return simulate;  // a sure plan
+    }
   }
+  for (const Candidate& c : viable) simulate[c.trajectory] = true;
   return simulate;
 }
 
@@ -366,6 +367,13 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
       ++counts.strongly_occluded;
     }
   }
+  // Which free tubes another tube lies on (their plans are not sure): part of classification.
+  for (std::size_t t = 0; t < result.tubes.size(); ++t) {
+    TubeClass& cls = result.classes[t];
+    if (cls.too_short || cls.occlusion != Occlusion::kNone) continue;
+    cls.lying_on = TubesLyingOn(result.tubes, t, params.certainty);
+    if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
+  }
   timer.Add("classification", t0);
   if (counts.too_short == counts.tubes) {
     result.total_seconds = SecondsSince(start);
@@ -376,12 +384,6 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
   ctx.max_z = MaxHeight(modeling, result.tubes);
   ctx.zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
   ctx.tube_grasps.resize(result.tubes.size());
-  for (std::size_t t = 0; t < result.tubes.size(); ++t) {
-    TubeClass& cls = result.classes[t];
-    if (cls.too_short || cls.occlusion != Occlusion::kNone) continue;
-    cls.lying_on = TubesLyingOn(result.tubes, t, params.certainty);
-    if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
-  }
 
   std::vector<Occlusion> stages = {Occlusion::kNone, Occlusion::kWeak};
   if (params.strongly_occluded_candidates) stages.push_back(Occlusion::kStrong);

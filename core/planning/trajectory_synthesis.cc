@@ -113,8 +113,10 @@ std::optional<std::array<EscapeCandidate, 2>> EscapeCandidates(const Tube& tube,
   return out;
 }
 
-std::vector<std::uint8_t> SideOfJointA(const Tube& tube, std::uint32_t joint) {
-  const std::vector<TubeJoint> joints = TubeJoints(tube);
+namespace {
+
+std::vector<std::uint8_t> SideOfJointA(const Tube& tube, const std::vector<TubeJoint>& joints,
+                                       std::uint32_t joint) {
   const std::vector<TubeBranch> branches = BranchesOf(tube);
   assert(joint < joints.size());
   // Vertices: cylinders 0..n−1, then nodes n..n+m−1; joined by every joint but `joint`, and by
@@ -150,14 +152,21 @@ std::vector<std::uint8_t> SideOfJointA(const Tube& tube, std::uint32_t joint) {
   return mask;
 }
 
+}  // namespace
+
+std::vector<std::uint8_t> SideOfJointA(const Tube& tube, std::uint32_t joint) {
+  return SideOfJointA(tube, TubeJoints(tube), joint);
+}
+
 std::optional<std::array<TreeEscapeCandidate, 2>> TreeEscapeCandidates(const Tube& tube, std::uint32_t joint,
                                                                        double constant_distance,
                                                                        const SafetyZone& zone) {
-  const TubeJoint j = TubeJoints(tube).at(joint);
+  const std::vector<TubeJoint> joints = TubeJoints(tube);
+  const TubeJoint& j = joints.at(joint);
   const Eigen::Vector3d line = Xy(j.b - j.a);
   if (line.norm() < kMinEscapeLineXy) return std::nullopt;
   const Eigen::Vector3d u = line.normalized();
-  const std::vector<std::uint8_t> side_a = SideOfJointA(tube, joint);
+  const std::vector<std::uint8_t> side_a = SideOfJointA(tube, joints, joint);
   std::array<TreeEscapeCandidate, 2> out;
   for (int i = 0; i < 2; ++i) {
     const bool towards_b = i == 0;  // the a side trails

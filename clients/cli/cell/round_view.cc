@@ -20,9 +20,8 @@ CellConfig CellOf(const v1::CellDescription& d, const CellConfig& fallback) {
   if (d.tube_radius() > 0) cell.tube.radius = d.tube_radius();
   if (d.tube_length() > 0) cell.tube.length = d.tube_length();
   if (d.tube_mass() > 0) cell.tube.mass = d.tube_mass();
-  if (d.tube_topology() == v1::TUBE_TOPOLOGY_LINEAR) cell.tube.topology = TubeTopology::kLinear;
-  if (d.tube_topology() == v1::TUBE_TOPOLOGY_BRANCHED) cell.tube.topology = TubeTopology::kBranched;
-  if (d.tube_topology() == v1::TUBE_TOPOLOGY_AUTO) cell.tube.topology = TubeTopology::kAuto;
+  if (const std::optional<TubeTopology> topology = FromProto(d.tube_topology()))
+    cell.tube.topology = *topology;
   return cell;
 }
 

@@ -2,8 +2,8 @@
 
 #include <limits>
 
-#include "core/common/segment_geometry.h"
 #include "core/common/tube_graph.h"
+#include "core/evaluation/virtual_labelling.h"
 #include "physics/trajectory_simulator.h"
 
 namespace tubepick::cli {
@@ -12,7 +12,7 @@ namespace {
 double DistanceToAxis(const Eigen::Vector3d& p, const Tube& tube) {
   double best = std::numeric_limits<double>::infinity();
   for (const AxisPiece& piece : TubeAxisPieces(tube))
-    best = std::min(best, ClosestPointsOfSegments(p, p, piece.a, piece.b).distance);
+    best = std::min(best, DistanceToSegment(p, piece.a, piece.b));
   return best;
 }
 
