@@ -113,10 +113,18 @@ TubeGeometry DrawTube(const RandomTubeParams& params, int id, std::mt19937_64& r
     } else {
       start = tube.Node(spec.from_node).centre;
       const Eigen::Vector3d& ref = away_tangent.at(spec.from_node);
-      if (!base_azimuth.contains(spec.from_node)) base_azimuth[spec.from_node] = 2.0 * M_PI * unit(rng);
-      const double azimuth = base_azimuth[spec.from_node] + spec.split_azimuth;
-      const Eigen::Vector3d perpendicular = Eigen::AngleAxisd(azimuth, ref) * ref.unitOrthogonal();
-      first_direction = std::cos(spec.split_angle) * ref + std::sin(spec.split_angle) * perpendicular;
+      if (spec.split_random) {
+        std::normal_distribution<double> normal(0.0, 1.0);
+        do {
+          first_direction = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        } while (!(first_direction.norm() > 1e-9));
+        first_direction.normalize();
+      } else {
+        if (!base_azimuth.contains(spec.from_node)) base_azimuth[spec.from_node] = 2.0 * M_PI * unit(rng);
+        const double azimuth = base_azimuth[spec.from_node] + spec.split_azimuth;
+        const Eigen::Vector3d perpendicular = Eigen::AngleAxisd(azimuth, ref) * ref.unitOrthogonal();
+        first_direction = std::cos(spec.split_angle) * ref + std::sin(spec.split_angle) * perpendicular;
+      }
       first = &first_direction;
     }
     const std::vector<Eigen::Vector3d> points = DrawChain(spec, lengths, start, first, rng);
@@ -166,6 +174,12 @@ RandomTubeParams RandomTubeParams::SetB() {
 }
 
 RandomTubeParams RandomTubeParams::SetC() {
+  RandomTubeParams params = SetCY();
+  for (std::size_t k = 1; k < params.branches.size(); ++k) params.branches[k].split_random = true;
+  return params;
+}
+
+RandomTubeParams RandomTubeParams::SetCY() {
   RandomTubeParams params;
   auto branch = [](int from, int to, double length, int c_min, int c_max, double azimuth) {
     TubeBranchSpec b;
@@ -190,7 +204,8 @@ RandomTubeParams RandomTubeParams::Preset(const std::string& name) {
   if (name == "A") return SetA();
   if (name == "B") return SetB();
   if (name == "C") return SetC();
-  throw InvalidArgument("unknown random tube preset '" + name + "' (expected A, B or C)");
+  if (name == "CY") return SetCY();
+  throw InvalidArgument("unknown random tube preset '" + name + "' (expected A, B, C or CY)");
 }
 
 void RandomTubeParams::Validate() const {

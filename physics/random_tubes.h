@@ -31,6 +31,10 @@ struct TubeBranchSpec {
   /// Non-root branches only: rotation of the first cylinder about the reference direction,
   /// radians, added to one random azimuth drawn per split node (so siblings keep their spacing).
   double split_azimuth = 0.0;
+  /// Non-root branches only: the first cylinder's direction is drawn uniformly over the sphere
+  /// instead (split_angle and split_azimuth unused); a draw that makes the tube intersect itself
+  /// is drawn again with the whole tube.
+  bool split_random = false;
 };
 
 /// Parameters of Algorithm 2 (thesis §4.5.1) for one tube shape.
@@ -55,10 +59,16 @@ struct RandomTubeParams {
   /// Set B: linear, 50 cm, 5–10 cylinders, 5°–45°.
   static RandomTubeParams SetB();
   /// Set C: branched (README-dataset.md): trunk 1–2 of 30 cm (5–10 cylinders), branches 1–3 and
-  /// 1–4 of 10 cm (2–5), 2–5 of 10 cm (2–5) and 2–6 of 15 cm (2–6), all 0°–20°. Each pair of
-  /// branches leaves its split node at 120° from the trunk and 180° apart in azimuth (a "double Y").
+  /// 1–4 of 10 cm (2–5), 2–5 of 10 cm (2–5) and 2–6 of 15 cm (2–6), all 0°–20°. Each branch
+  /// leaves its split node in a random direction (split_random): in the published C1, C3 and C5
+  /// files the angle between a branch and the trunk's continuation spreads over 0°–165° and the
+  /// angle between sibling branches over 0°–180° (docs/ACCURACY.md).
   static RandomTubeParams SetC();
-  /// "A", "B" or "C". @throws InvalidArgument for anything else.
+  /// Set C's topology and lengths with Y-piece fittings: each pair of branches leaves its split
+  /// node at 120° from the trunk and 180° apart in azimuth, so the three arms of every junction
+  /// are 120° apart (hose assemblies with symmetric Y-pieces).
+  static RandomTubeParams SetCY();
+  /// "A", "B", "C" or "CY". @throws InvalidArgument for anything else.
   static RandomTubeParams Preset(const std::string& name);
 
   /// @throws InvalidArgument naming the field and value (e.g. C_max·CL_min > L).

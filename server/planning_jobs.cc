@@ -26,6 +26,7 @@ ModelingResult Model(const PlanningJob& job, const RawRegion& raw_region_Bin, st
   input.X_BinSensor = job.cell.sensor.X_BinSensor;
   input.bin = job.cell.bin;
   input.topology = job.cell.tube.topology;
+  input.junction_shape = job.cell.tube.junction_shape;
   input.seed = job.seed;
   ModelingParams params = job.params.modeling;
   params.threads = threads;

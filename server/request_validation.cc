@@ -112,6 +112,13 @@ TubeTopology TopologyOf(v1::TubeTopology topology, TubeTopology configured, cons
                         " (expected TUBE_TOPOLOGY_LINEAR, _BRANCHED or _AUTO)");
 }
 
+JunctionShape JunctionShapeOf(v1::JunctionShape shape, JunctionShape configured, const std::string& field) {
+  if (shape == v1::JUNCTION_SHAPE_UNSPECIFIED) return configured;
+  if (const std::optional<JunctionShape> known = FromProto(shape)) return *known;
+  throw InvalidArgument(field + ": unknown value " + std::to_string(static_cast<int>(shape)) +
+                        " (expected JUNCTION_SHAPE_ANY, _WYE or _TEE)");
+}
+
 }  // namespace
 
 std::string_view CheckCloudBytes(std::string_view xyz, std::uint64_t max_points, const std::string& field) {
@@ -159,6 +166,8 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   RequireRange(cell->tube_mass(), kMinTubeMass, kMaxTubeMass, false, f + "tube_mass", "kg");
   out.tube.mass = cell->tube_mass();
   out.tube.topology = TopologyOf(cell->tube_topology(), defaults.cell.tube.topology, f + "tube_topology");
+  out.tube.junction_shape = JunctionShapeOf(cell->tube_junction_shape(), defaults.cell.tube.junction_shape,
+                                            f + "tube_junction_shape");
 
   if (!cell->has_place_pose()) throw InvalidArgument(f + "place_pose: required when the cell is given");
   out.place.X_BinPlace = FromProto(cell->place_pose(), f + "place_pose");

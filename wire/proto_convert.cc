@@ -169,6 +169,31 @@ std::optional<TubeTopology> FromProto(v1::TubeTopology topology) {
   }
 }
 
+v1::JunctionShape ToProto(JunctionShape shape) {
+  switch (shape) {
+    case JunctionShape::kAny:
+      return v1::JUNCTION_SHAPE_ANY;
+    case JunctionShape::kWye:
+      return v1::JUNCTION_SHAPE_WYE;
+    case JunctionShape::kTee:
+      return v1::JUNCTION_SHAPE_TEE;
+  }
+  return v1::JUNCTION_SHAPE_UNSPECIFIED;
+}
+
+std::optional<JunctionShape> FromProto(v1::JunctionShape shape) {
+  switch (shape) {
+    case v1::JUNCTION_SHAPE_ANY:
+      return JunctionShape::kAny;
+    case v1::JUNCTION_SHAPE_WYE:
+      return JunctionShape::kWye;
+    case v1::JUNCTION_SHAPE_TEE:
+      return JunctionShape::kTee;
+    default:
+      return std::nullopt;
+  }
+}
+
 v1::ResolutionMotion ToProto(const ResolutionMotion& motion) {
   v1::ResolutionMotion out;
   *out.mutable_axis_tcp() = ToProto(motion.axis_Tcp);
@@ -222,6 +247,7 @@ v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isome
   out.set_tube_length(cell.tube.length);
   out.set_tube_mass(cell.tube.mass);
   out.set_tube_topology(ToProto(cell.tube.topology));
+  out.set_tube_junction_shape(ToProto(cell.tube.junction_shape));
   *out.mutable_place_pose() = ToProto(cell.place.X_BinPlace);
   return out;
 }

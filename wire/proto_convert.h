@@ -50,6 +50,10 @@ std::optional<ResolutionVariant> FromProto(v1::ResolutionVariant variant);
 /// and for numbers the enum does not define.
 v1::TubeTopology ToProto(TubeTopology topology);
 std::optional<TubeTopology> FromProto(v1::TubeTopology topology);
+/// The wire value of a cell's junction shape, and back: std::nullopt for
+/// JUNCTION_SHAPE_UNSPECIFIED and for numbers the enum does not define.
+v1::JunctionShape ToProto(JunctionShape shape);
+std::optional<JunctionShape> FromProto(v1::JunctionShape shape);
 
 /// The CellDescription of `cell` with the sensor pose of the capture (X_BinSensor).
 v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isometry3d& X_BinSensor);

@@ -31,6 +31,25 @@ std::string ToString(TubeTopology topology) {
   return "?";
 }
 
+std::string ToString(JunctionShape shape) {
+  switch (shape) {
+    case JunctionShape::kAny:
+      return "any";
+    case JunctionShape::kWye:
+      return "wye";
+    case JunctionShape::kTee:
+      return "tee";
+  }
+  return "?";
+}
+
+JunctionShape ParseJunctionShape(const std::string& text, const std::string& field) {
+  if (text == "any") return JunctionShape::kAny;
+  if (text == "wye") return JunctionShape::kWye;
+  if (text == "tee") return JunctionShape::kTee;
+  throw InvalidArgument(field + ": unknown junction shape '" + text + "' (expected any, wye or tee)");
+}
+
 TubeTopology ParseTubeTopology(const std::string& text, const std::string& field) {
   if (text == "linear") return TubeTopology::kLinear;
   if (text == "branched") return TubeTopology::kBranched;

@@ -47,6 +47,24 @@ std::string ToString(TubeTopology topology);
 /// @throws InvalidArgument naming `field`, the value and the accepted ones.
 TubeTopology ParseTubeTopology(const std::string& text, const std::string& field);
 
+/// The fitting at the junctions of branched tubes, as the cell knows it: modeling accepts a
+/// junction only when the angles between its three arms fit the shape
+/// (modeling.junctions.shape_tolerance).
+enum class JunctionShape {
+  /// No expectation (mixed fittings, wire harnesses): any angles, up to
+  /// modeling.junctions.max_branches_per_node arms.
+  kAny,
+  /// Y-pieces: three arms 120° apart.
+  kWye,
+  /// T-pieces: a straight run and a branch at 90° to it (arms 90°, 90°, 180° apart).
+  kTee,
+};
+
+/// "any", "wye", "tee".
+std::string ToString(JunctionShape shape);
+/// @throws InvalidArgument naming `field`, the value and the accepted ones.
+JunctionShape ParseJunctionShape(const std::string& text, const std::string& field);
+
 struct TubeConfig {
   /// Tube radius, metres.
   double radius = 0.0125;
@@ -56,6 +74,8 @@ struct TubeConfig {
   double mass = 0.055;
   /// Linear tubes, branched ones, or decided per scene.
   TubeTopology topology = TubeTopology::kLinear;
+  /// Branched tubes: the fitting at their junctions.
+  JunctionShape junction_shape = JunctionShape::kAny;
 };
 
 /// Where placed tubes go: X_BinPlace is the destination frame the tube's PCA frame is aligned

@@ -30,6 +30,9 @@ void DescribeFields(Visit& v, TubeConfig& tube) {
   v.Enum(
       "topology", tube.topology, [](TubeTopology t) { return ToString(t); }, ParseTubeTopology,
       "linear, branched (hose assemblies: junctions are looked for) or auto (decided per scene).");
+  v.Enum(
+      "junction_shape", tube.junction_shape, [](JunctionShape s) { return ToString(s); }, ParseJunctionShape,
+      "Branched tubes: any, wye (arms 120 deg apart) or tee (a run and a branch at 90 deg).");
 }
 
 template <typename Visit>

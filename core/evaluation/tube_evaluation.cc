@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/common/errors.h"
+#include "core/common/tube_graph.h"
 
 namespace tubepick {
 namespace {
@@ -17,6 +18,52 @@ void RequireFraction(double value, const std::string& name) {
 
 double Ratio(std::uint64_t numerator, std::uint64_t denominator) {
   return denominator == 0 ? 0.0 : static_cast<double>(numerator) / static_cast<double>(denominator);
+}
+
+// Per cylinder of one virtual tube: its points per real tube (the background last).
+using CylinderCounts = std::vector<std::vector<std::uint32_t>>;
+
+// The real tube holding most of a cylinder's points, or −1 (too few points, or background).
+std::int32_t CylinderMajority(const std::vector<std::uint32_t>& counts, const EvaluationParams& params) {
+  std::uint64_t total = 0;
+  for (const std::uint32_t c : counts) total += c;
+  if (total < params.touch_min_points) return -1;
+  const auto best = std::max_element(counts.begin(), counts.end() - 1);
+  return *best == 0 ? -1 : static_cast<std::int32_t>(best - counts.begin());
+}
+
+// Where a virtual tube mixes real tubes: impure cylinders, joints and junction nodes between
+// cylinders of different real tubes.
+void CountMixing(const Tube& tube, const CylinderCounts& counts, const EvaluationParams& params,
+                 VirtualTubeEvaluation* v) {
+  std::vector<std::int32_t> majority(counts.size());
+  for (std::size_t c = 0; c < counts.size(); ++c) {
+    majority[c] = CylinderMajority(counts[c], params);
+    std::uint64_t total = 0;
+    for (const std::uint32_t k : counts[c]) total += k;
+    if (majority[c] >= 0 && Ratio(counts[c][static_cast<std::size_t>(majority[c])], total) < params.purity) {
+      ++v->mixed_cylinders;
+    }
+  }
+  // Per node: the real tube of each branch's cylinder nearest it.
+  std::vector<std::vector<std::int32_t>> at_node(NodesOf(tube).size());
+  for (const TubeBranch& b : BranchesOf(tube)) {
+    std::int32_t first = -1, previous = -1;
+    for (std::uint32_t c = b.first_cylinder; c < b.first_cylinder + b.cylinder_count; ++c) {
+      if (majority[c] < 0) continue;
+      if (previous >= 0 && majority[c] != previous) ++v->mixed_joints;
+      if (first < 0) first = majority[c];
+      previous = majority[c];
+    }
+    if (first >= 0) {
+      at_node[b.from_node].push_back(first);
+      at_node[b.to_node].push_back(previous);
+    }
+  }
+  for (std::vector<std::int32_t>& reals : at_node) {
+    std::sort(reals.begin(), reals.end());
+    if (std::unique(reals.begin(), reals.end()) - reals.begin() > 1) ++v->mixed_nodes;
+  }
 }
 
 }  // namespace
@@ -148,24 +195,27 @@ SceneEvaluation EvaluateScene(const ModelingResult& result, const std::vector<st
   }
   {
     // Per cylinder: points attributed to it, and how many of them are on the tube's majority.
-    std::vector<std::vector<std::uint32_t>> on_cylinder(m), on_majority(m);
+    std::vector<CylinderCounts> counts(m);
     for (std::uint32_t i = 0; i < m; ++i) {
-      on_cylinder[i].assign(result.tubes[i].cylinders.size(), 0);
-      on_majority[i].assign(result.tubes[i].cylinders.size(), 0);
+      counts[i].assign(result.tubes[i].cylinders.size(), std::vector<std::uint32_t>(n + 1, 0));
     }
     for (std::size_t p = 0; p < n_points; ++p) {
       const std::int32_t v = labels.tube[p];
       if (v < 0 || labels.cylinder[p] < 0) continue;
-      ++on_cylinder[v][labels.cylinder[p]];
-      if (truth[p] >= 0 && truth[p] == out.virtual_tubes[v].majority) ++on_majority[v][labels.cylinder[p]];
+      ++counts[v][labels.cylinder[p]][truth[p] >= 0 ? static_cast<std::uint32_t>(truth[p]) : n];
     }
     for (std::uint32_t i = 0; i < m; ++i) {
       VirtualTubeEvaluation& v = out.virtual_tubes[i];
-      for (std::size_t c = 0; c < on_cylinder[i].size(); ++c) {
-        if (on_cylinder[i][c] == 0) continue;
-        if (Ratio(on_majority[i][c], on_cylinder[i][c]) < params.cylinder_purity) ++v.stray_cylinders;
+      for (const std::vector<std::uint32_t>& on_cylinder : counts[i]) {
+        std::uint64_t total = 0;
+        for (const std::uint32_t k : on_cylinder) total += k;
+        if (total == 0) continue;
+        const std::uint64_t on_majority =
+            v.majority >= 0 ? on_cylinder[static_cast<std::size_t>(v.majority)] : 0;
+        if (Ratio(on_majority, total) < params.cylinder_purity) ++v.stray_cylinders;
       }
       v.pure = v.majority >= 0 && v.purity >= params.purity && v.stray_cylinders == 0;
+      CountMixing(result.tubes[i], counts[i], params, &v);
     }
   }
 

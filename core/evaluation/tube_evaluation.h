@@ -93,6 +93,14 @@ struct VirtualTubeEvaluation {
   double purity = 0.0;
   /// Cylinders whose points are mostly not on `majority`.
   std::uint32_t stray_cylinders = 0;
+  /// Where it mixes real tubes (a diagnosis of merges): cylinders holding less than `purity`
+  /// of their points on one real tube (segmentation or fitting), joints inside a branch between
+  /// cylinders of different real tubes (end-to-end joining) and junction nodes whose branches
+  /// start on different real tubes (junction joining). Cylinders with fewer than
+  /// touch_min_points points are not counted.
+  std::uint32_t mixed_cylinders = 0;
+  std::uint32_t mixed_joints = 0;
+  std::uint32_t mixed_nodes = 0;
   /// Pure for `majority` (see EvaluationParams).
   bool pure = false;
   /// Its real tube in the optimal matching, or −1.

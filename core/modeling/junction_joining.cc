@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -66,6 +67,52 @@ double ArcAt(const std::vector<AxisPiece>& pieces, double position) {
 
 double ArcLength(const std::vector<AxisPiece>& pieces) {
   return ArcAt(pieces, static_cast<double>(pieces.size()));
+}
+
+// The point on a chain's axis pieces at an arc length (clamped to the chain).
+Eigen::Vector3d PointAtArc(const std::vector<AxisPiece>& pieces, double arc) {
+  for (const AxisPiece& piece : pieces) {
+    const double length = (piece.b - piece.a).norm();
+    if (arc <= length) return length > 0.0 ? piece.a + (arc / length) * (piece.b - piece.a) : piece.a;
+    arc -= length;
+  }
+  return pieces.back().b;
+}
+
+// Where the arms of a T-junction's run are measured: this far from the node along the run.
+constexpr double kRunArmProbe = 0.03;
+
+// The angles between the three arms of a junction shape, ascending; empty for kAny.
+std::vector<double> ArmAngles(JunctionShape shape) {
+  switch (shape) {
+    case JunctionShape::kAny:
+      return {};
+    case JunctionShape::kWye:
+      return {2.0 * kPi / 3.0, 2.0 * kPi / 3.0, 2.0 * kPi / 3.0};
+    case JunctionShape::kTee:
+      return {kPi / 2.0, kPi / 2.0, kPi};
+  }
+  return {};
+}
+
+// How far a junction's arms (directions away from its node) are from the shape: the largest
+// difference between their angles and the shape's, both ascending; 0 for kAny, infinite for a
+// node with another number of arms.
+double ShapeDeviation(const std::vector<Eigen::Vector3d>& arms, JunctionShape shape) {
+  const std::vector<double> expected = ArmAngles(shape);
+  if (expected.empty()) return 0.0;
+  if (arms.size() != expected.size()) return std::numeric_limits<double>::infinity();
+  std::vector<double> angles;
+  for (std::size_t i = 0; i < arms.size(); ++i) {
+    for (std::size_t k = i + 1; k < arms.size(); ++k) {
+      angles.push_back(std::acos(std::clamp(arms[i].normalized().dot(arms[k].normalized()), -1.0, 1.0)));
+    }
+  }
+  std::sort(angles.begin(), angles.end());
+  double deviation = 0.0;
+  for (std::size_t i = 0; i < angles.size(); ++i)
+    deviation = std::max(deviation, std::abs(angles[i] - expected[i]));
+  return deviation;
 }
 
 class Forest {
@@ -229,14 +276,43 @@ std::vector<MeetingNode> ClusterMeetings(const std::vector<EndMeeting>& meetings
   return junctions;
 }
 
+// A Y-piece's node with a junction shape: the three of its ends whose arms fit the shape best,
+// or nullopt when none fit within shape_tolerance (a chance end among them, or no Y at all).
+std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<Tube>& chains,
+                                       JunctionShape shape, double tolerance) {
+  if (shape == JunctionShape::kAny) return n;
+  std::optional<MeetingNode> best;
+  double best_deviation = tolerance;
+  const std::size_t k = n.ends.size();
+  for (std::size_t a = 0; a < k; ++a) {
+    for (std::size_t b = a + 1; b < k; ++b) {
+      for (std::size_t c = b + 1; c < k; ++c) {
+        const std::vector<std::pair<std::uint32_t, bool>> ends = {n.ends[a], n.ends[b], n.ends[c]};
+        std::vector<Eigen::Vector3d> arms;
+        for (const auto& [chain, at_end] : ends) arms.push_back(-EndOf(chains[chain], at_end).out);
+        const double deviation = ShapeDeviation(arms, shape);
+        if (deviation > best_deviation) continue;
+        best_deviation = deviation;
+        best = n;
+        best->ends = ends;
+      }
+    }
+  }
+  return best;
+}
+
 Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
-                const std::vector<Junction>& candidates, const JunctionParams& params,
+                const std::vector<Junction>& candidates, const JunctionParams& params, JunctionShape shape,
                 const StopToken* stop) {
   Forest forest(chains);
   std::vector<std::array<bool, 2>> end_used(chains.size(), {false, false});
   Accepted out;
   // Y-pieces first: their ends are spoken for; then T-pieces; then end-to-end links.
-  auto accept_meeting = [&](const MeetingNode& n) {
+  auto accept_meeting = [&](const MeetingNode& meeting) {
+    const std::optional<MeetingNode> fitting =
+        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains, shape, params.shape_tolerance) : meeting;
+    if (!fitting) return;
+    const MeetingNode& n = *fitting;
     std::vector<std::uint32_t> roots;
     double links = 0.0;
     for (const auto& [chain, at_end] : n.ends) {
@@ -271,8 +347,8 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
     std::vector<HostNode>& nodes = out.nodes_of_host[j.host];
     auto near = std::find_if(nodes.begin(), nodes.end(),
                              [&](const HostNode& n) { return std::abs(n.arc - arc) < params.node_spacing; });
-    if (near != nodes.end() && near->degree + 1 > params.max_branches_per_node) continue;
-    if (near == nodes.end() && 3 > params.max_branches_per_node) continue;
+    const std::uint32_t max_branches = shape == JunctionShape::kAny ? params.max_branches_per_node : 3;
+    if (near != nodes.end() && near->degree + 1 > max_branches) continue;
     if (near == nodes.end()) {
       nodes.push_back(HostNode{arc, j.host_position, j.p_Bin, 2});
       near = nodes.end() - 1;
@@ -440,6 +516,7 @@ void JunctionParams::Validate() const {
         "modeling.junctions.min_meeting_ends: " + std::to_string(min_meeting_ends) +
         " is out of range [2, max_branches_per_node = " + std::to_string(max_branches_per_node) + "]");
   }
+  RequireInRange(shape_tolerance, 0.0, kPi, "modeling.junctions.shape_tolerance");
   RequireNonNegative(node_spacing, "modeling.junctions.node_spacing");
   RequireNonNegative(max_tube_length, "modeling.junctions.max_tube_length");
   RequireNonNegative(chain_max_distance, "modeling.junctions.chain_max_distance");
@@ -449,7 +526,8 @@ void JunctionParams::Validate() const {
   RequireNonNegative(auto_min_per_tube, "modeling.junctions.auto_min_per_tube");
 }
 
-std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params) {
+std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
+                                    JunctionShape shape) {
   params.Validate();
   const double cos_min = std::cos(params.min_angle);
   std::vector<Junction> out;
@@ -480,6 +558,12 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
           const double arc = ArcAt(pieces[h], position);
           if (arc < params.node_spacing || arc_length[h] - arc < params.node_spacing) continue;
           Junction j{b, at_end, h, position, arc, piece.a + cp.t * axis, cp.s * reach, cp.distance};
+          if (shape != JunctionShape::kAny) {
+            const std::vector<Eigen::Vector3d> arms = {-end.out,
+                                                       PointAtArc(pieces[h], arc - kRunArmProbe) - j.p_Bin,
+                                                       PointAtArc(pieces[h], arc + kRunArmProbe) - j.p_Bin};
+            if (ShapeDeviation(arms, shape) > params.shape_tolerance) continue;
+          }
           if (!best || j.reach + j.offset < best->reach + best->offset) best = j;
         }
         if (best) out.push_back(*best);
@@ -494,11 +578,11 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
 }
 
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                              const StopToken* stop) {
+                              JunctionShape shape, const StopToken* stop) {
   params.Validate();
   ThrowIfStopped(stop, "joining");
   const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params), params),
-                                   FindJunctions(chains, params), params, stop);
+                                   FindJunctions(chains, params, shape), params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),

@@ -31,8 +31,17 @@ struct JunctionParams {
   /// Fewest free ends meeting at one point that make a node there (a Y-piece has 3; 2 also
   /// accepts a Y-piece whose third branch is hidden, as a kinked link).
   std::uint32_t min_meeting_ends = 3;
-  /// Most branches meeting at one node (3 = T- and Y-pieces only).
+  /// Most branches meeting at one node (3 = T- and Y-pieces only). A junction shape other than
+  /// `any` allows three.
   std::uint32_t max_branches_per_node = 4;
+  /// A junction shape other than `any` (tube.junction_shape): largest difference between an
+  /// angle between two of the junction's arms and the shape's, radians. The arms are the
+  /// branches' axes at the node; a run cut at a T-junction gives two, each from the node to the
+  /// run's axis 3 cm away (a run fitted straight through a Y-piece's bend still shows the bend).
+  /// On generated set-CY bins (Y-pieces), with the shape-blind joining, the arms of 95 % of the
+  /// right junctions were within 40° of 120° and those of 31 of 32 chance ones (a tube's end
+  /// against another's side) 40° or more off; 55° gave the most correct tubes (docs/ACCURACY.md).
+  double shape_tolerance = 55.0 * 3.14159265358979323846 / 180.0;
   /// A junction closer than this to the other chain's free end is not one (that would be an end
   /// to end join), and junctions closer than this on one chain become one node, metres.
   double node_spacing = 0.02;
@@ -82,7 +91,9 @@ struct Junction {
 
 /// Candidate junctions of linear `chains` (JoinTubes' output), cheapest first (reach + offset),
 /// each within the limits of `params` on its own.
-std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params);
+/// With a junction shape other than `any`, only junctions whose arms fit it (shape_tolerance).
+std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
+                                    JunctionShape shape = JunctionShape::kAny);
 
 /// What junction joining made of a scene's chains.
 struct JunctionJoining {
@@ -104,10 +115,11 @@ struct JunctionJoining {
 /// no node more than max_branches_per_node branches and keeps the tube within max_tube_length.
 /// A host chain is cut at each T-junction on it (the cylinder under it is split at the
 /// junction's foot); every branch end is linked to its node by a joint (TubeJoints). Tubes
-/// without a junction are returned as they came (linear, implicit graph). Deterministic.
+/// without a junction are returned as they came (linear, implicit graph). With a junction shape
+/// other than `any`, every node has three arms whose angles fit the shape. Deterministic.
 /// @throws InvalidArgument for invalid parameters. @throws Cancelled when `stop` fires.
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                              const StopToken* stop = nullptr);
+                              JunctionShape shape = JunctionShape::kAny, const StopToken* stop = nullptr);
 
 /// Topology `auto`: whether a scene shows branched tubes (at least auto_min_junctions junctions
 /// and auto_min_per_tube per tube joining left, or at least auto_min_y_pieces Y-pieces).

@@ -232,7 +232,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
     chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
     const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
-    JunctionJoining joined = JoinJunctions(chains, params.junctions, stop);
+    JunctionJoining joined = JoinJunctions(chains, params.junctions, input.junction_shape, stop);
     const bool branched =
         input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
     spdlog::debug("junctions: {} ({} Y-pieces) joining {} of {} chains into {} tubes; topology {}: {}",

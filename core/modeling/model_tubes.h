@@ -31,6 +31,8 @@ struct ModelingInput {
   /// The shape of the cell's tubes (CellConfig tube.topology): whether joining looks for
   /// junctions.
   TubeTopology topology = TubeTopology::kLinear;
+  /// The fitting at their junctions (CellConfig tube.junction_shape).
+  JunctionShape junction_shape = JunctionShape::kAny;
 };
 
 struct StageTiming {

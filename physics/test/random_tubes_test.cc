@@ -100,8 +100,8 @@ TEST(RandomTubes, SetBAnglesUpTo45Degrees) {
   EXPECT_GT(max_angle, 30.0 * kDeg);  // the wider range is used
 }
 
-TEST(RandomTubes, SetCIsBranched) {
-  const RandomTubeParams params = RandomTubeParams::SetC();
+TEST(RandomTubes, SetCYIsBranchedWithYPieces) {
+  const RandomTubeParams params = RandomTubeParams::SetCY();
   for (const TubeGeometry& tube : GenerateRandomTubes(20, params, 3)) {
     SCOPED_TRACE("tube " + std::to_string(tube.id));
     EXPECT_FALSE(tube.IsLinear());
@@ -121,6 +121,50 @@ TEST(RandomTubes, SetCIsBranched) {
     EXPECT_NEAR(Angle(b13[1] - b13[0], b14[1] - b14[0]), 120.0 * kDeg, kAngleTol);
     const auto n = trunk.size();
     EXPECT_NEAR(Angle(trunk[n - 2] - trunk[n - 1], b25[1] - b25[0]), 120.0 * kDeg, kAngleTol);
+  }
+}
+
+TEST(RandomTubes, SetCBranchesLeaveInRandomDirectionsAsPublished) {
+  const RandomTubeParams params = RandomTubeParams::SetC();
+  double low = M_PI, high = 0.0, sibling_low = M_PI, sibling_high = 0.0;
+  for (const TubeGeometry& tube : GenerateRandomTubes(20, params, 3)) {
+    SCOPED_TRACE("tube " + std::to_string(tube.id));
+    EXPECT_EQ(tube.Degree(1), 3);
+    EXPECT_EQ(tube.Degree(2), 3);
+    EXPECT_NEAR(tube.Length(), 0.75, kLengthTol);
+    EXPECT_GE(SelfClearance(tube), 0.0);
+    for (const TubeBranchSpec& spec : params.branches) {
+      ExpectChain(Chain(tube, spec.from_node, spec.to_node), spec, params.length_resolution);
+    }
+    const auto trunk = Chain(tube, 1, 2);
+    const auto b13 = Chain(tube, 1, 3), b14 = Chain(tube, 1, 4);
+    // The trunk's continuation through node 1 (pointing away from the trunk).
+    const Eigen::Vector3d continuation = trunk[0] - trunk[1];
+    for (const auto* b : {&b13, &b14}) {
+      const double a = Angle(continuation, (*b)[1] - (*b)[0]);
+      low = std::min(low, a);
+      high = std::max(high, a);
+    }
+    const double sibling = Angle(b13[1] - b13[0], b14[1] - b14[0]);
+    sibling_low = std::min(sibling_low, sibling);
+    sibling_high = std::max(sibling_high, sibling);
+  }
+  // The published C1, C3 and C5 files spread over 0°–165° and 0°–180°; 40 draws cover most of it.
+  EXPECT_LT(low, 30.0 * kDeg);
+  EXPECT_GT(high, 110.0 * kDeg);
+  EXPECT_LT(sibling_low, 60.0 * kDeg);
+  EXPECT_GT(sibling_high, 140.0 * kDeg);
+}
+
+TEST(RandomTubes, PresetsByName) {
+  EXPECT_TRUE(RandomTubeParams::Preset("C").branches[1].split_random);
+  EXPECT_FALSE(RandomTubeParams::Preset("CY").branches[1].split_random);
+  EXPECT_EQ(RandomTubeParams::Preset("CY").branches.size(), 5u);
+  try {
+    RandomTubeParams::Preset("D");
+    FAIL() << "no throw";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("'D' (expected A, B, C or CY)"), std::string::npos) << e.what();
   }
 }
 

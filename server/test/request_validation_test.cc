@@ -259,6 +259,24 @@ TEST(ValidatePlanPick, TubeTopologyComesFromTheCellOrTheServer) {
   }
 }
 
+TEST(ValidatePlanPick, JunctionShapeComesFromTheCellOrTheServer) {
+  PlanningDefaults defaults;
+  defaults.cell.tube.junction_shape = JunctionShape::kTee;
+  v1::PlanPickRequest request = ValidRequest();
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.junction_shape, JunctionShape::kTee);
+  request.mutable_cell()->set_tube_junction_shape(v1::JUNCTION_SHAPE_WYE);
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.junction_shape, JunctionShape::kWye);
+  request.mutable_cell()->set_tube_junction_shape(v1::JUNCTION_SHAPE_ANY);
+  EXPECT_EQ(ValidatePlanPick(request, defaults).cell.tube.junction_shape, JunctionShape::kAny);
+  request.mutable_cell()->set_tube_junction_shape(static_cast<v1::JunctionShape>(7));
+  try {
+    (void)ValidatePlanPick(request, defaults);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("cell.tube_junction_shape: unknown value 7"));
+  }
+}
+
 TEST(ValidatePlanPick, NearlyUnitQuaternionIsNormalised) {
   v1::PlanPickRequest request = ValidRequest();
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));

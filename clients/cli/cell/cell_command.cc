@@ -50,6 +50,7 @@ void WithShapes(const std::string& set, devices::sim::SimCellParams* p) {
     if (p->cell.tube.length > 0.0) p->cell.tube.mass *= tree.tube.length / p->cell.tube.length;
     p->cell.tube.length = tree.tube.length;
     p->cell.tube.topology = tree.tube.topology;
+    p->cell.tube.junction_shape = tree.tube.junction_shape;
   }
   p->tube_shape = shape;
 }
@@ -412,9 +413,10 @@ void AddCellCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option(
          "--shapes", o->shapes,
-         "Tube shapes of the simulated bins: A (20° bends), B (45°) or C (branched trees, pvc only); "
+         "Tube shapes of the simulated bins: A (20° bends), B (45°), C (branched trees, as published: "
+         "branches in random directions) or CY (trees with Y-pieces, arms 120° apart); trees are pvc only; "
          "default: A for pvc, B for rubber")
-      ->check(CLI::IsMember({"A", "B", "C"}));
+      ->check(CLI::IsMember({"A", "B", "C", "CY"}));
   cmd->add_option("--server", o->server,
                   "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
       ->capture_default_str();

@@ -22,6 +22,8 @@ CellConfig CellOf(const v1::CellDescription& d, const CellConfig& fallback) {
   if (d.tube_mass() > 0) cell.tube.mass = d.tube_mass();
   if (const std::optional<TubeTopology> topology = FromProto(d.tube_topology()))
     cell.tube.topology = *topology;
+  if (const std::optional<JunctionShape> shape = FromProto(d.tube_junction_shape()))
+    cell.tube.junction_shape = *shape;
   return cell;
 }
 

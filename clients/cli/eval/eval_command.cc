@@ -40,8 +40,9 @@ struct EvalOptions {
   std::uint32_t per_count = 20;
   std::string preset = "A";
   std::string report_dir;
-  std::string joining;   // "", "greedy", "global"
-  std::string topology;  // "", "linear", "branched", "auto"
+  std::string joining;         // "", "greedy", "global"
+  std::string topology;        // "", "linear", "branched", "auto"
+  std::string junction_shape;  // "", "any", "wye", "tee"
   std::uint32_t jobs = 1;
   std::uint32_t pictures_per_count = 2;
   /// Cloud points of each scene's 3-D page; 0 = no pages.
@@ -297,8 +298,12 @@ void Run(const EvalOptions& o) {
   CellConfig cell = LoadCell(o.common);
   if (!o.topology.empty()) {
     cell.tube.topology = ParseTubeTopology(o.topology, "--topology");
+    if (!o.generate.empty()) cell.tube.junction_shape = CellForPreset(cell, o.preset).tube.junction_shape;
   } else if (!o.generate.empty()) {
     cell = CellForPreset(cell, o.preset);
+  }
+  if (!o.junction_shape.empty()) {
+    cell.tube.junction_shape = ParseJunctionShape(o.junction_shape, "--junction-shape");
   }
   Params params = LoadParamsFor(o.common);
   if (o.joining == "greedy") params.modeling.joining.strategy = JoiningStrategy::kGreedy;
@@ -317,13 +322,16 @@ void Run(const EvalOptions& o) {
   run.params_path = o.common.params_path;
   run.joining_strategy = params.modeling.joining.strategy == JoiningStrategy::kGlobal ? "global" : "greedy";
   run.topology = ToString(cell.tube.topology);
+  run.junction_shape = ToString(cell.tube.junction_shape);
   run.params_yaml = DumpParams(params);
   run.evaluation_params = eval_params;
   run.modeling_seed = o.common.seed;
   run.jobs = jobs;
   run.modeling_threads = params.modeling.threads;
-  fmt::print(stderr, "eval: {} scenes ({}), profile {}, joining {}, topology {}, {} job(s)\n",
-             scene_jobs.size(), run.source, run.profile, run.joining_strategy, run.topology, jobs);
+  fmt::print(stderr,
+             "eval: {} scenes ({}), profile {}, joining {}, topology {}, junction shape {}, {} job(s)\n",
+             scene_jobs.size(), run.source, run.profile, run.joining_strategy, run.topology,
+             run.junction_shape, jobs);
 
   // Every scene is independent and fully seeded: results land in input order whatever the
   // number of workers, so the report does not depend on --jobs (timings aside).
@@ -422,7 +430,7 @@ void AddEvalCommand(CLI::App& app) {
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
   cmd->add_option("--preset", o->preset, "Tube shape set of generated scenes")
-      ->check(CLI::IsMember({"A", "B", "C"}))
+      ->check(CLI::IsMember({"A", "B", "C", "CY"}))
       ->capture_default_str();
   cmd->add_option("--seed", o->common.seed,
                   "Base seed: generated scene k with N tubes uses seed + 1000 N + k; also the modeling and "
@@ -441,6 +449,9 @@ void AddEvalCommand(CLI::App& app) {
                   "Override the cell's tube.topology (default: the cell's; generated branched presets "
                   "model a linear cell's tubes as branched)")
       ->check(CLI::IsMember({"linear", "branched", "auto"}));
+  cmd->add_option("--junction-shape", o->junction_shape,
+                  "Override the cell's tube.junction_shape (default: the cell's; generated set C: wye)")
+      ->check(CLI::IsMember({"any", "wye", "tee"}));
   cmd->add_option("--report", o->report_dir, "Directory for report.md, report.json and images/")->required();
   cmd->add_option(
          "--jobs", o->jobs,

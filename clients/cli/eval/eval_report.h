@@ -58,6 +58,8 @@ struct EvalRun {
   std::string joining_strategy;
   /// The tube topology modeled ("linear", "branched", "auto").
   std::string topology = "linear";
+  /// The junction shape expected ("any", "wye", "tee").
+  std::string junction_shape = "any";
   /// The full params YAML used (DumpParams).
   std::string params_yaml;
   EvaluationParams evaluation_params;

@@ -90,6 +90,9 @@ json SceneJson(const EvaluatedScene& s) {
                     {"majority", v.majority},
                     {"purity", v.purity},
                     {"stray_cylinders", v.stray_cylinders},
+                    {"mixed_cylinders", v.mixed_cylinders},
+                    {"mixed_joints", v.mixed_joints},
+                    {"mixed_nodes", v.mixed_nodes},
                     {"pure", v.pure},
                     {"matched_real", v.matched_real}});
   }
@@ -143,6 +146,7 @@ std::string FormatJsonReport(const EvalRun& run, const std::vector<ReportImage>&
   j["params_file"] = run.params_path;
   j["joining_strategy"] = run.joining_strategy;
   j["topology"] = run.topology;
+  j["junction_shape"] = run.junction_shape;
   j["modeling_seed"] = run.modeling_seed;
   j["jobs"] = run.jobs;
   j["modeling_threads"] = run.modeling_threads;

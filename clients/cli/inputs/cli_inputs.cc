@@ -63,6 +63,7 @@ ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, co
   input.X_BinSensor = cell.sensor.X_BinSensor;
   input.bin = cell.bin;
   input.topology = cell.tube.topology;
+  input.junction_shape = cell.tube.junction_shape;
   input.seed = seed;
   return input;
 }

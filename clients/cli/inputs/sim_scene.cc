@@ -1,5 +1,8 @@
 #include "clients/cli/inputs/sim_scene.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "physics/scene_generator.h"
 
 namespace tubepick::cli {
@@ -12,6 +15,13 @@ CellConfig CellForPreset(CellConfig cell, const std::string& preset) {
   if (tubes.branches.size() > 1 && cell.tube.topology == TubeTopology::kLinear) {
     cell.tube.topology = TubeTopology::kBranched;
   }
+  // Set CY's branches leave their split node 120° from the trunk and 180° apart in azimuth: the
+  // arms of a symmetric Y-piece. Set C's leave in random directions: any shape.
+  const bool wyes = tubes.branches.size() > 1 &&
+                    std::all_of(tubes.branches.begin() + 1, tubes.branches.end(), [](const auto& b) {
+                      return !b.split_random && std::abs(b.split_angle - 2.0 * M_PI / 3.0) < 1e-9;
+                    });
+  if (wyes && cell.tube.junction_shape == JunctionShape::kAny) cell.tube.junction_shape = JunctionShape::kWye;
   return cell;
 }
 

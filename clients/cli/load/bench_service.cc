@@ -102,6 +102,7 @@ Stages InProcessCall(const BenchCloud& cloud, const Params& params, std::uint32_
   input.X_BinSensor = cell.sensor.X_BinSensor;
   input.bin = cell.bin;
   input.topology = cell.tube.topology;
+  input.junction_shape = cell.tube.junction_shape;
   input.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
   ModelingParams modeling_params = params.modeling;
   modeling_params.threads = threads;

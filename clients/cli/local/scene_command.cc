@@ -80,8 +80,9 @@ void AddSceneCommand(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("scene", "Drop random tubes into the bin, scan them, write cloud + ground truth");
   cmd->add_option("--tubes", o->tubes, "Number of tubes")->check(CLI::Range(1, 30))->capture_default_str();
-  cmd->add_option("--preset", o->preset, "Tube shape set (thesis / dataset sets A, B, C)")
-      ->check(CLI::IsMember({"A", "B", "C"}))
+  cmd->add_option("--preset", o->preset,
+                  "Tube shape set (thesis / dataset sets A, B, C; CY: set C with Y-pieces)")
+      ->check(CLI::IsMember({"A", "B", "C", "CY"}))
       ->capture_default_str();
   cmd->add_option("--seed", o->common.seed, "Seed of the tube shapes, the drop and the scan")
       ->capture_default_str();

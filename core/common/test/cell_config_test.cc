@@ -61,6 +61,22 @@ TEST(CellConfig, ReadsTheTopologyAndRejectsAnUnknownOneNamingIt) {
   }
 }
 
+TEST(CellConfig, ReadsTheJunctionShapeAndRejectsAnUnknownOneNamingIt) {
+  EXPECT_EQ(ParseCellConfig("{}").tube.junction_shape, JunctionShape::kAny);
+  EXPECT_EQ(ParseCellConfig("tube:\n  junction_shape: wye\n").tube.junction_shape, JunctionShape::kWye);
+  EXPECT_EQ(ParseCellConfig("tube:\n  junction_shape: tee\n").tube.junction_shape, JunctionShape::kTee);
+  EXPECT_EQ(
+      ParseCellConfig(DumpCellConfig(ParseCellConfig("tube:\n  junction_shape: tee\n"))).tube.junction_shape,
+      JunctionShape::kTee);
+  try {
+    ParseCellConfig("tube:\n  junction_shape: y\n");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(),
+                HasSubstr("tube.junction_shape: unknown junction shape 'y' (expected any, wye or tee)"));
+  }
+}
+
 TEST(CellConfig, RejectsOutOfRangeRadius) {
   try {
     ParseCellConfig("tube:\n  radius: -0.01\n");

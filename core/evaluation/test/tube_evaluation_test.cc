@@ -121,6 +121,28 @@ TEST(EvaluateScene, TwoTubesMergedIntoOneAreNotCorrect) {
   EXPECT_EQ(e.real_tubes[1].failure, TubeFailure::kMerged);
   EXPECT_FALSE(e.virtual_tubes[0].pure);
   EXPECT_EQ(e.virtual_tubes[0].stray_cylinders, 1u);
+  // Where: at the joint between its two cylinders (end-to-end joining), not in a cylinder.
+  EXPECT_EQ(e.virtual_tubes[0].mixed_joints, 1u);
+  EXPECT_EQ(e.virtual_tubes[0].mixed_nodes, 0u);
+  EXPECT_EQ(e.virtual_tubes[0].mixed_cylinders, 0u);
+}
+
+TEST(EvaluateScene, AMergeAtAJunctionNodeIsCountedThere) {
+  // A tree: two branches on real tube 0 meet at x = −0.16, where a third branch on real tube 1
+  // leaves (a chance junction).
+  Fixture f;
+  f.AddRealTube(0, -0.30, -0.02, 0.0, [](double) { return 0; });
+  f.AddRealTube(1, 0.02, 0.30, 0.0, [](double) { return 0; });
+  f.AddVirtualTube(
+      {FloorCylinder(-0.30, -0.16, 0.0), FloorCylinder(-0.16, -0.02, 0.0), FloorCylinder(0.02, 0.30, 0.0)});
+  Tube& tree = f.result.tubes[0];
+  tree.nodes = {{{-0.30, 0, kR}}, {{-0.16, 0, kR}}, {{-0.02, 0, kR}}, {{0.30, 0, kR}}};
+  tree.branches = {{0, 1, 0, 1}, {1, 2, 1, 1}, {1, 3, 2, 1}};
+  const SceneEvaluation e = f.Evaluate(2);
+  EXPECT_EQ(e.not_correct, 2u);
+  EXPECT_EQ(e.virtual_tubes[0].mixed_nodes, 1u);
+  EXPECT_EQ(e.virtual_tubes[0].mixed_joints, 0u);
+  EXPECT_EQ(e.virtual_tubes[0].mixed_cylinders, 0u);
 }
 
 TEST(EvaluateScene, MissedHiddenAndUnderCoveredTubes) {

@@ -122,6 +122,67 @@ TEST(JunctionJoining, LimitsKeepTreesAndSizes) {
       ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_branches_per_node: 2")));
 }
 
+// A run along x with a branch at `branch_degrees` from it, ending 3 cm from the run's axis.
+std::vector<Tube> BranchOffARun(double branch_degrees) {
+  const Eigen::Vector3d foot(0.16, 0, kR);
+  return {Chain({Cyl({0, 0, kR}, {0.10, 0, kR}, 0), Cyl({0.10, 0, kR}, {0.30, 0, kR}, 1)}),
+          Chain({Cyl(foot + 0.13 * Dir(branch_degrees), foot + 0.03 * Dir(branch_degrees), 2)})};
+}
+
+TEST(JunctionJoining, AJunctionShapeAcceptsOnlyJunctionsWhoseArmsFitIt) {
+  const std::vector<Tube> wye = YPiece({0.05, -0.02, kR}, 0.025, 0);
+  const std::vector<Tube> tee = BranchOffARun(90.0);
+  const JunctionParams params;
+  EXPECT_EQ(JoinJunctions(wye, params, JunctionShape::kWye).tubes.size(), 1u);
+  EXPECT_EQ(JoinJunctions(tee, params, JunctionShape::kTee).tubes.size(), 1u);
+  EXPECT_EQ(JoinJunctions(tee, params, JunctionShape::kAny).tubes.size(), 1u);
+  // A tee's arms are 90°, 90° and 180° apart: 60° from a wye's 120°, beyond the 55° tolerance.
+  EXPECT_EQ(JoinJunctions(tee, params, JunctionShape::kWye).tubes.size(), 2u);
+  EXPECT_EQ(JoinJunctions(wye, params, JunctionShape::kTee).tubes.size(), 3u);
+  // A branch at 60° to the run (arms 60°, 120°, 180°): 60° off a wye's, 30° off a tee's.
+  EXPECT_EQ(JoinJunctions(BranchOffARun(60.0), params, JunctionShape::kWye).tubes.size(), 2u);
+  EXPECT_EQ(JoinJunctions(BranchOffARun(60.0), params, JunctionShape::kTee).tubes.size(), 1u);
+  JunctionParams strict;
+  strict.shape_tolerance = 20.0 * kPi / 180.0;
+  EXPECT_EQ(JoinJunctions(BranchOffARun(60.0), strict, JunctionShape::kTee).tubes.size(), 2u);
+  EXPECT_EQ(JoinJunctions(BranchOffARun(80.0), strict, JunctionShape::kTee).tubes.size(), 1u);
+}
+
+TEST(JunctionJoining, AWyeTakesTheThreeEndsThatFitItAndLeavesAChanceFourth) {
+  const Eigen::Vector3d node(0.05, -0.02, kR);
+  std::vector<Tube> chains = YPiece(node, 0.025, 0);
+  // A fourth tube's end meets the node too, 35° from one arm.
+  const Eigen::Vector3d d = Dir(90.0 + 35.0);
+  chains.push_back(Chain({Cyl(node + 0.20 * d, node + 0.025 * d, 3)}));
+  const JunctionJoining any = JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny);
+  ASSERT_EQ(any.tubes.size(), 1u);  // any shape: a node of four branches
+  const JunctionJoining wye = JoinJunctions(chains, JunctionParams{}, JunctionShape::kWye);
+  ASSERT_EQ(wye.tubes.size(), 2u);
+  EXPECT_EQ(wye.y_pieces, 1u);
+  EXPECT_EQ(wye.tubes[1].cylinders.size(), 1u);
+  EXPECT_EQ(wye.tubes[1].cylinders[0].segment_id, 3u);
+}
+
+TEST(JunctionJoining, ARunFittedThroughTheBendOfAWyeShowsTheBend) {
+  // The run's two cylinders meet at the node, 120° apart (the chain joining went through the
+  // bend); the third arm ends 3 cm from the node. The run's arms are measured 3 cm from the node.
+  const Eigen::Vector3d node(0.10, 0.05, kR);
+  std::vector<Tube> chains = {
+      Chain({Cyl(node + 0.10 * Dir(210), node, 0), Cyl(node, node + 0.10 * Dir(-30), 1)}),
+      Chain({Cyl(node + 0.13 * Dir(90), node + 0.03 * Dir(90), 2)})};
+  const JunctionJoining joined = JoinJunctions(chains, JunctionParams{}, JunctionShape::kWye);
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  EXPECT_TRUE(joined.tubes[0].branched());
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}, JunctionShape::kTee).tubes.size(), 2u);
+}
+
+TEST(JunctionJoining, ShapeToleranceIsValidated) {
+  JunctionParams params;
+  params.shape_tolerance = -0.1;
+  EXPECT_THAT([&] { params.Validate(); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.shape_tolerance")));
+}
+
 TEST(JunctionJoining, AutoTopologyNeedsSeveralJunctionsOrYPieces) {
   JunctionParams params;
   JunctionJoining joined;
