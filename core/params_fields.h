@@ -212,6 +212,9 @@ void DescribeFields(Visit& v, GraspFilterParams& p) {
   v("finger_length", p.finger_length);
   v("finger_tip_depth", p.finger_tip_depth);
   v("max_points_in_fingers", p.max_points_in_fingers);
+  v("approach_check", p.approach_check, "beyond the thesis: the pads' and housing's way down");
+  v("max_points_in_approach", p.max_points_in_approach);
+  v("approach_column_height", p.approach_column_height, "m above the grasp point");
   v("grid_cell_size", p.grid_cell_size);
   v("workspace_min", p.workspace_min);
   v("workspace_max", p.workspace_max);

@@ -58,6 +58,7 @@ v1::PlanningCounts CountsToProto(const PlanningCounts& c) {
   pc.set_rejected_workspace(c.rejected_workspace);
   pc.set_rejected_tool(c.rejected_tool);
   pc.set_rejected_fingers(c.rejected_fingers);
+  pc.set_rejected_approach(c.rejected_approach);
   pc.set_non_occluded_lain_on(c.non_occluded_lain_on);
   return pc;
 }

@@ -125,9 +125,41 @@ std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const Gras
   }
   if (lo > hi) return {0.0, 0.0};
   const double bottom = -params.finger_tip_depth;
-  const double top = params.finger_length - params.finger_tip_depth;
+  const double top = params.approach_check ? std::max(params.finger_length - params.finger_tip_depth,
+                                                      params.approach_column_height)
+                                           : params.finger_length - params.finger_tip_depth;
   // 1 mm slack against rounding at the band's edges.
   return {lo + bottom - 1e-3, hi + top + 1e-3};
+}
+
+std::array<OrientedBox, 3> ApproachColumns(const Grasp& grasp, const GraspFilterParams& params,
+                                           const ToolParams& tool) {
+  // z_Tcp points down: heights above the grasp point are negative z_Tcp.
+  auto column = [&](double x, double y, double bottom_height, const Eigen::Vector2d& size_xy) {
+    const double height = std::max(0.0, params.approach_column_height - bottom_height);
+    OrientedBox box;
+    box.X_BinBox.linear() = grasp.X_BinTcp.linear();
+    box.X_BinBox.translation() = grasp.X_BinTcp * Eigen::Vector3d(x, y, -(bottom_height + 0.5 * height));
+    box.half_size = 0.5 * Eigen::Vector3d(size_xy.x(), size_xy.y(), height);
+    return box;
+  };
+  const double pad_top = params.finger_length - params.finger_tip_depth;
+  const double offset = 0.5 * (grasp.opening_width + params.finger_thickness);
+  const Eigen::Vector2d pad(params.finger_width, params.finger_thickness);
+  const double housing_bottom = tool.finger_size.z() - tool.finger_tip_depth + tool.housing_gap;
+  return {column(0.0, offset, pad_top, pad), column(0.0, -offset, pad_top, pad),
+          column(0.0, 0.0, housing_bottom, tool.housing_size.head<2>())};
+}
+
+bool ApproachBlocked(const Grasp& grasp, const RawCloudIndex& raw, const GraspFilterParams& params,
+                     const ToolParams& tool) {
+  const std::size_t limit = params.max_points_in_approach;
+  std::size_t count = 0;
+  for (const OrientedBox& box : ApproachColumns(grasp, params, tool)) {
+    count += raw.CountInBox(box, limit - count);
+    if (count > limit) return true;
+  }
+  return false;
 }
 
 bool FingersCollide(const Grasp& grasp, const RawCloudIndex& raw, const GraspFilterParams& params) {

@@ -12,6 +12,7 @@
 
 #include "core/common/types.h"
 #include "core/planning/grasp_synthesis.h"
+#include "core/planning/tool_clearance.h"
 #include "core/planning/trajectory.h"
 
 namespace tubepick {
@@ -30,6 +31,16 @@ struct GraspFilterParams {
   /// A grasp is rejected when more than this many raw points lie inside the finger boxes
   /// (Table 5.3: 20).
   std::uint32_t max_points_in_fingers = 20;
+  /// Beyond the thesis: the tool's way down. A grasp is rejected when more than
+  /// max_points_in_approach raw points lie in the columns the pads and the housing sweep on the
+  /// vertical approach (ApproachColumns), from above the finger boxes and from the housing's
+  /// bottom (ToolParams) up to approach_column_height above the grasp point. The finger test
+  /// looks at the grasp pose only: a branch standing up beside the grasp, or a tube crossing
+  /// higher up, meets the gripper on its way down (in the simulated cell: the F/T reference at
+  /// the pre-grasp pose disturbed, a safe stop).
+  bool approach_check = true;
+  std::uint32_t max_points_in_approach = 20;
+  double approach_column_height = 0.5;
   /// Cell size of the xy grid the raw cloud is binned into once per plan, metres.
   double grid_cell_size = 0.01;
   /// Workspace box, bin frame: every waypoint added to the grasp point must lie inside, metres.
@@ -80,8 +91,20 @@ std::array<OrientedBox, 2> FingerBoxes(const Grasp& grasp, const GraspFilterPara
 
 /// The z band [lo, hi] every finger box of a grasp on `tubes` lies in: a grasp point's z is
 /// between its cylinder's endpoint heights and the boxes span [G_z − finger_tip_depth,
-/// G_z − finger_tip_depth + finger_length] (the TCP z axis is vertical). Empty tubes ⇒ (0, 0).
+/// G_z − finger_tip_depth + finger_length] (the TCP z axis is vertical); with approach_check, up
+/// to the approach columns' top (G_z + approach_column_height). Empty tubes ⇒ (0, 0).
 std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const GraspFilterParams& params);
+
+/// The columns the tool sweeps on its vertical approach to `grasp` (opened to its opening width):
+/// above each finger box (the pads, GraspFilterParams' finger size) and above the housing's bottom
+/// (ToolParams: housing_size centred on the TCP's z axis, its bottom housing_gap above the pads'
+/// top), each up to approach_column_height above the grasp point.
+std::array<OrientedBox, 3> ApproachColumns(const Grasp& grasp, const GraspFilterParams& params,
+                                           const ToolParams& tool);
+
+/// More than max_points_in_approach raw points in the approach columns (together).
+bool ApproachBlocked(const Grasp& grasp, const RawCloudIndex& raw, const GraspFilterParams& params,
+                     const ToolParams& tool);
 
 /// Filter (a): more than max_points_in_fingers raw points inside the finger boxes (together).
 bool FingersCollide(const Grasp& grasp, const RawCloudIndex& raw, const GraspFilterParams& params);

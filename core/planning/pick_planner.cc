@@ -35,12 +35,20 @@ double MaxHeight(const ModelingResult& modeling, const std::vector<Tube>& tubes)
 }
 
 // Grasps of one tube, synthesized once, with the finger test cached (it does not depend on the
-// trajectory): -1 unknown, 0 clear, 1 collides.
+// trajectory): -1 unknown, 0 clear, 1 fingers collide, 2 approach blocked.
 struct TubeGrasps {
   bool synthesized = false;
   std::vector<Grasp> grasps;
   std::vector<std::int8_t> collides;
 };
+
+// The cloud tests of a grasp: 1 when the fingers collide at the grasp pose (thesis filter (a)),
+// 2 when the tool's way down is blocked (filters.approach_check), else 0.
+std::int8_t CloudCollision(const Grasp& grasp, const RawCloudIndex& raw, const PlanningParams& params) {
+  if (FingersCollide(grasp, raw, params.filters)) return 1;
+  if (params.filters.approach_check && ApproachBlocked(grasp, raw, params.filters, params.tool)) return 2;
+  return 0;
+}
 
 struct Candidate {
   std::uint32_t trajectory = 0;  // index into the stage's trajectories
@@ -130,9 +138,13 @@ std::vector<Candidate> ViableCandidates(PlanningContext& ctx, const std::vector<
         ++counts.rejected_tool;
         continue;
       }
-      if (tg.collides[gi] < 0) tg.collides[gi] = FingersCollide(grasp, *ctx.raw, params.filters) ? 1 : 0;
-      if (tg.collides[gi] > 0) {
+      if (tg.collides[gi] < 0) tg.collides[gi] = CloudCollision(grasp, *ctx.raw, params);
+      if (tg.collides[gi] == 1) {
         ++counts.rejected_fingers;
+        continue;
+      }
+      if (tg.collides[gi] == 2) {
+        ++counts.rejected_approach;
         continue;
       }
       viable.push_back(Candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi)});
@@ -264,6 +276,7 @@ void PlanningParams::Validate() const {
   RequirePositive(f.finger_length, "planning.filters.finger_length");
   RequireFinite(f.finger_tip_depth, "planning.filters.finger_tip_depth");
   RequirePositive(f.grid_cell_size, "planning.filters.grid_cell_size");
+  RequireInRange(f.approach_column_height, 0.0, 2.0, "planning.filters.approach_column_height");
   RequireFiniteComponents(f.workspace_min, "planning.filters.workspace_min");
   RequireFiniteComponents(f.workspace_max, "planning.filters.workspace_max");
   for (int k = 0; k < 3; ++k) {

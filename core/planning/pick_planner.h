@@ -63,12 +63,13 @@ struct PlanningCounts {
   std::uint32_t trajectories = 0;
   std::uint32_t simulated_trajectories = 0;
   /// (grasp, trajectory) pairs tested, and how many each filter rejected (the first failing one,
-  /// tested in the order section, workspace, tool clearance, fingers).
+  /// tested in the order section, workspace, tool clearance, fingers, approach).
   std::uint64_t grasp_candidates = 0;
   std::uint64_t rejected_section = 0;
   std::uint64_t rejected_workspace = 0;
   std::uint64_t rejected_tool = 0;
   std::uint64_t rejected_fingers = 0;
+  std::uint64_t rejected_approach = 0;
   std::uint32_t plans = 0;
 };
 

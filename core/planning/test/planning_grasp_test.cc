@@ -176,6 +176,54 @@ TEST(GraspFilters, FingersToleratePointsUpToTheThreshold) {
   EXPECT_TRUE(FingersCollide(GraspOnXTube(0.0), RawCloudIndex(both, params.grid_cell_size), params));
 }
 
+// A horizontal patch of 30 points (a tube crossing higher up) centred at (x, y, z).
+void AddPatch(Points* pts, double x, double y, double z) {
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < 5; ++k) pts->emplace_back(x - 0.005 + 0.002 * i, y - 0.004 + 0.002 * k, z);
+  }
+}
+
+TEST(GraspFilters, ApproachColumnsGeometry) {
+  const Grasp g = GraspOnXTube(0.0);  // grasp point at z = r, opening 0.045
+  const GraspFilterParams params;     // pads 0.05 high, tips 0.005 below the axis; columns 0.5
+  const ToolParams tool;              // housing 0.06 × 0.13 × 0.09, 0.02 above pads 0.05 high
+  const auto columns = ApproachColumns(g, params, tool);
+  for (int i = 0; i < 2; ++i) {
+    // Pads' columns: from the finger box's top (r + 0.045) to r + 0.5, over the finger's footprint.
+    const OrientedBox& c = columns[i];
+    EXPECT_NEAR(std::abs(c.X_BinBox.translation().y()), 0.0275, kTol);
+    EXPECT_NEAR(c.X_BinBox.translation().z() - c.half_size.z(), kR + 0.045, kTol);
+    EXPECT_NEAR(c.X_BinBox.translation().z() + c.half_size.z(), kR + 0.5, kTol);
+  }
+  // The housing's column: from r + 0.05 − 0.005 + 0.02 up, 0.06 along the tube, 0.13 across.
+  EXPECT_NEAR(columns[2].X_BinBox.translation().z() - columns[2].half_size.z(), kR + 0.065, kTol);
+  EXPECT_NEAR(2 * columns[2].half_size.x(), 0.06, kTol);
+  EXPECT_NEAR(2 * columns[2].half_size.y(), 0.13, kTol);
+  EXPECT_FALSE(columns[2].Contains(g.p_Bin_grasp));
+}
+
+TEST(GraspFilters, ApproachIsBlockedByWhatTheToolMeetsOnItsWayDown) {
+  GraspFilterParams params;
+  const ToolParams tool;
+  Points pts = TubeAndFloor();
+  // A tube crossing 8 cm above the grasp at x = 0 (over the housing's footprint, above the pads).
+  AddPatch(&pts, 0.0, 0.0, kR + 0.08);
+  const RawCloudIndex raw(pts, params.grid_cell_size);
+  EXPECT_FALSE(FingersCollide(GraspOnXTube(0.0), raw, params));  // the thesis test sees nothing
+  EXPECT_TRUE(ApproachBlocked(GraspOnXTube(0.0), raw, params, tool));
+  EXPECT_FALSE(ApproachBlocked(GraspOnXTube(0.1), raw, params, tool));  // 10 cm away: clear
+  // Over a pad, 6 cm up (above the finger box, below the housing's bottom).
+  Points pad = TubeAndFloor();
+  AddPatch(&pad, 0.0, 0.028, kR + 0.06);
+  EXPECT_TRUE(ApproachBlocked(GraspOnXTube(0.0), RawCloudIndex(pad, params.grid_cell_size), params, tool));
+  // Beyond the column's height, and up to the threshold: clear.
+  params.approach_column_height = 0.07;
+  EXPECT_FALSE(ApproachBlocked(GraspOnXTube(0.0), raw, params, tool));
+  params = GraspFilterParams{};
+  params.max_points_in_approach = 30;
+  EXPECT_FALSE(ApproachBlocked(GraspOnXTube(0.0), raw, params, tool));
+}
+
 TEST(GraspFilters, RawCloudIndexMatchesBruteForce) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> ux(-0.4f, 0.4f), uy(-0.3f, 0.3f), uz(0.0f, 0.2f);
@@ -214,18 +262,27 @@ TEST(GraspFilters, RawCloudIndexEmptyAndWide) {
 }
 
 TEST(GraspFilters, FingerBandDropsFloorAndKeepsVerdicts) {
-  const GraspFilterParams params;
+  GraspFilterParams params;
+  params.approach_check = false;
   const std::vector<Tube> tubes = {MakeTube(0, {FlatCylinder(-0.2, 0.0, 0.2, 0.0, 1)})};
   const auto [lo, hi] = FingerBandZ(tubes, params);
   EXPECT_NEAR(lo, kR - 0.005 - 0.001, kTol);
   EXPECT_NEAR(hi, kR - 0.005 + 0.05 + 0.001, kTol);
+  // With the approach check the band reaches the approach columns' top.
+  params.approach_check = true;
+  const auto [lo_approach, hi_approach] = FingerBandZ(tubes, params);
+  EXPECT_NEAR(lo_approach, lo, kTol);
+  EXPECT_NEAR(hi_approach, kR + 0.5 + 0.001, kTol);
   Points pts = TubeAndFloor();
   AddFingerPoints(&pts, 0.0, 21);
+  AddPatch(&pts, 0.1, 0.0, kR + 0.08);
   const RawCloudIndex all(pts, params.grid_cell_size);
-  const RawCloudIndex banded(pts, params.grid_cell_size, lo, hi);
+  const RawCloudIndex banded(pts, params.grid_cell_size, lo_approach, hi_approach);
   EXPECT_LT(banded.size(), all.size());  // the floor patch is gone
   for (const Grasp& g : SynthesizeGrasps(tubes[0], GraspParams{})) {
     EXPECT_EQ(FingersCollide(g, banded, params), FingersCollide(g, all, params));
+    EXPECT_EQ(ApproachBlocked(g, banded, params, ToolParams{}),
+              ApproachBlocked(g, all, params, ToolParams{}));
     for (const OrientedBox& box : FingerBoxes(g, params)) {
       EXPECT_EQ(banded.CountInBox(box, pts.size()), all.CountInBox(box, pts.size()));
     }
