@@ -125,9 +125,8 @@ std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const Gras
   }
   if (lo > hi) return {0.0, 0.0};
   const double bottom = -params.finger_tip_depth;
-  const double top = params.approach_check ? std::max(params.finger_length - params.finger_tip_depth,
-                                                      params.approach_column_height)
-                                           : params.finger_length - params.finger_tip_depth;
+  double top = params.finger_length - params.finger_tip_depth;
+  if (params.approach_check) top = std::max(top, params.approach_column_height);
   // 1 mm slack against rounding at the band's edges.
   return {lo + bottom - 1e-3, hi + top + 1e-3};
 }

@@ -298,7 +298,7 @@ void Run(const EvalOptions& o) {
   CellConfig cell = LoadCell(o.common);
   if (!o.topology.empty()) {
     cell.tube.topology = ParseTubeTopology(o.topology, "--topology");
-    if (!o.generate.empty()) cell.tube.junction_shape = CellForPreset(cell, o.preset).tube.junction_shape;
+    if (!o.generate.empty()) cell.tube.junction_shape = PresetJunctionShape(o.preset);
   } else if (!o.generate.empty()) {
     cell = CellForPreset(cell, o.preset);
   }
@@ -450,7 +450,7 @@ void AddEvalCommand(CLI::App& app) {
                   "model a linear cell's tubes as branched)")
       ->check(CLI::IsMember({"linear", "branched", "auto"}));
   cmd->add_option("--junction-shape", o->junction_shape,
-                  "Override the cell's tube.junction_shape (default: the cell's; generated set C: wye)")
+                  "Override the cell's tube.junction_shape (default: the cell's; generated set CY: wye)")
       ->check(CLI::IsMember({"any", "wye", "tee"}));
   cmd->add_option("--report", o->report_dir, "Directory for report.md, report.json and images/")->required();
   cmd->add_option(

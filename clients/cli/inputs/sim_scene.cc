@@ -15,14 +15,19 @@ CellConfig CellForPreset(CellConfig cell, const std::string& preset) {
   if (tubes.branches.size() > 1 && cell.tube.topology == TubeTopology::kLinear) {
     cell.tube.topology = TubeTopology::kBranched;
   }
+  if (cell.tube.junction_shape == JunctionShape::kAny) cell.tube.junction_shape = PresetJunctionShape(preset);
+  return cell;
+}
+
+JunctionShape PresetJunctionShape(const std::string& preset) {
+  const physics::RandomTubeParams tubes = physics::RandomTubeParams::Preset(preset);
   // Set CY's branches leave their split node 120° from the trunk and 180° apart in azimuth: the
   // arms of a symmetric Y-piece. Set C's leave in random directions: any shape.
   const bool wyes = tubes.branches.size() > 1 &&
                     std::all_of(tubes.branches.begin() + 1, tubes.branches.end(), [](const auto& b) {
                       return !b.split_random && std::abs(b.split_angle - 2.0 * M_PI / 3.0) < 1e-9;
                     });
-  if (wyes && cell.tube.junction_shape == JunctionShape::kAny) cell.tube.junction_shape = JunctionShape::kWye;
-  return cell;
+  return wyes ? JunctionShape::kWye : JunctionShape::kAny;
 }
 
 SimulatedScene SimulateScene(const CellConfig& cell, int tube_count, const std::string& preset,

@@ -16,10 +16,16 @@ struct SimulatedScene {
   physics::ScanResult scan;
 };
 
-/// The cell that describes `preset`'s tubes: tube.length is the preset's total curve length, and
-/// a branched preset (C) makes a linear cell's topology branched (an `auto` cell stays auto).
+/// The cell that describes `preset`'s tubes: tube.length is the preset's total curve length, a
+/// branched preset (C, CY) makes a linear cell's topology branched (an `auto` cell stays auto) and
+/// a cell expecting any junction shape gets the preset's (PresetJunctionShape).
 /// @throws InvalidArgument for an unknown preset.
 CellConfig CellForPreset(CellConfig cell, const std::string& preset);
+
+/// The fitting at `preset`'s junctions: wye when every branch leaves its split node 120° from the
+/// trunk (set CY), else any (linear sets; set C's random directions).
+/// @throws InvalidArgument for an unknown preset.
+JunctionShape PresetJunctionShape(const std::string& preset);
 
 /// `tube_count` tubes of `preset` ("A", "B", "C"; radius and mass from the cell) dropped into
 /// the cell's bin and scanned with the default scanner, all driven by `seed`. With preset A this
