@@ -72,6 +72,25 @@ PlausibilityTally::PlausibilityTally(const BinConfig& bin, const PlausibilityPar
   sample_.reserve(expected_points / stride_ + 1);
 }
 
+void PlausibilityTally::Add(const float* x_Bin, const float* y_Bin, const float* z_Bin, std::size_t n) {
+  // Branch-free counts in 32 bits over the arrays (vectorised), then the sampled points.
+  const float vx = volume_x_, vy = volume_y_, vz_lo = volume_z_lo_, vz_hi = volume_z_hi_;
+  const float fx = floor_x_, fy = floor_y_, ft = floor_tolerance_;
+  std::uint32_t inside = 0, on_floor = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float x = std::abs(x_Bin[i]), y = std::abs(y_Bin[i]), z = z_Bin[i];
+    inside += static_cast<std::uint32_t>((x <= vx) & (y <= vy) & (z >= vz_lo) & (z <= vz_hi));
+    on_floor += static_cast<std::uint32_t>((x <= fx) & (y <= fy) & (std::abs(z) <= ft));
+  }
+  inside_ += inside;
+  on_floor_ += on_floor;
+  // Add() samples a point when until_sample_ is 0, then waits stride_ − 1 points.
+  std::size_t next = until_sample_;
+  for (; next < n; next += stride_) sample_.emplace_back(x_Bin[next], y_Bin[next], z_Bin[next]);
+  until_sample_ = next - n;
+  points_ += n;
+}
+
 CloudPlausibility PlausibilityTally::Finish() const {
   CloudPlausibility e;
   e.points = points_;

@@ -64,6 +64,9 @@ class PlausibilityTally {
   /// k-th point, about 100 k of them).
   PlausibilityTally(const BinConfig& bin, const PlausibilityParams& params, std::size_t expected_points);
 
+  /// Adds n finite points given as coordinate arrays: the same as Add() of each, in order.
+  void Add(const float* x_Bin, const float* y_Bin, const float* z_Bin, std::size_t n);
+
   void Add(const Eigen::Vector3f& p_Bin) {
     const float x = std::abs(p_Bin.x()), y = std::abs(p_Bin.y()), z = p_Bin.z();
     inside_ += (x <= volume_x_ && y <= volume_y_ && z >= volume_z_lo_ && z <= volume_z_hi_) ? 1 : 0;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -217,6 +218,63 @@ TEST(PrepareCloud, EvidenceEqualsTheCheckOnTheFinitePoints) {
   EXPECT_EQ(prepared.plausibility.extent, e.extent);
   EXPECT_EQ(prepared.plausibility.median, e.median);
   EXPECT_TRUE(prepared.plausibility.plausible());
+}
+
+// The pass maps points a chunk at a time: each point must still be the one Eigen's R * p + t
+// gives (bit for bit), in input order with its input index, across chunk boundaries and around
+// dropped points.
+TEST(PrepareCloud, MapsEveryPointAsEigenDoesAcrossChunks) {
+  Points points_Sensor;
+  for (int i = 0; i < 5000; ++i) {  // not a multiple of any chunk size
+    points_Sensor.emplace_back(0.37f * std::sin(0.1f * i) * 1000.f, 0.29f * std::cos(0.07f * i) * 1000.f,
+                               (1.1f + 0.05f * std::sin(0.013f * i)) * 1000.f);
+  }
+  points_Sensor[1023] = Eigen::Vector3f(kNaN, 0.f, 1.f);
+  points_Sensor[1024] = Eigen::Vector3f(0.f, 0.f, kInf);
+  points_Sensor[4999] = Eigen::Vector3f(0.f, kNaN, 1.f);
+  const Eigen::Isometry3d X = TiltedSensorPose();
+  const PreparedCloud prepared = PrepareCloud(points_Sensor, LengthUnit::kMillimetre, X, {});
+  const Eigen::Matrix3f R = (X.linear() * 0.001).cast<float>();
+  const Eigen::Vector3f t = X.translation().cast<float>();
+  ASSERT_EQ(prepared.working_Bin.size(), 4997u);
+  std::size_t k = 0;
+  for (std::uint32_t i = 0; i < points_Sensor.size(); ++i) {
+    if (i == 1023 || i == 1024 || i == 4999) continue;
+    const Eigen::Vector3f expected = R * points_Sensor[i] + t;
+    ASSERT_EQ(prepared.working_source_index[k], i);
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(prepared.working_Bin[k].x()),
+              std::bit_cast<std::uint32_t>(expected.x()))
+        << i;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(prepared.working_Bin[k].y()),
+              std::bit_cast<std::uint32_t>(expected.y()))
+        << i;
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(prepared.working_Bin[k].z()),
+              std::bit_cast<std::uint32_t>(expected.z()))
+        << i;
+    ++k;
+  }
+  EXPECT_EQ(prepared.dropped_non_finite, 3u);
+}
+
+// Above 100 k points the evidence samples every k-th point; the pass must sample the same points
+// as adding them one at a time, whatever the chunks.
+TEST(PrepareCloud, EvidenceOfALargeCloudSamplesAsThePointByPointCheck) {
+  Points points_Sensor;
+  const Eigen::Isometry3f X_SensorBin = SensorConfig::DefaultX_BinSensor().inverse().cast<float>();
+  std::mt19937 rng(7);  // irregular points: another sample gives other quantiles
+  std::uniform_real_distribution<float> x(-0.35f, 0.35f), y(-0.18f, 0.18f), z(0.0f, 0.03f);
+  for (int i = 0; i < 350003; ++i) {  // a sample stride of 3, which 1024 is no multiple of
+    points_Sensor.push_back(X_SensorBin * Eigen::Vector3f(x(rng), y(rng), z(rng)));
+  }
+  const Eigen::Isometry3d X = SensorConfig::DefaultX_BinSensor();
+  const PreparedCloud prepared = PrepareCloud(points_Sensor, LengthUnit::kMetre, X, {});
+  const CloudPlausibility e = CheckCloudAgainstCell(prepared.working_Bin, BinConfig{}, PlausibilityParams{});
+  EXPECT_EQ(prepared.plausibility.points, 350003u);
+  EXPECT_EQ(prepared.plausibility.inside, e.inside);
+  EXPECT_EQ(prepared.plausibility.on_floor, e.on_floor);
+  EXPECT_GT(e.on_floor, 0u);
+  EXPECT_EQ(prepared.plausibility.extent, e.extent);
+  EXPECT_EQ(prepared.plausibility.median, e.median);
 }
 
 }  // namespace
