@@ -108,11 +108,6 @@ void SimCellParams::Validate() const {
           m.bending_stiffness, "> 0 N·m²");
   Require(m.damping_ratio > 0.0 && m.damping_ratio <= 10.0, "material.damping_ratio", m.damping_ratio,
           "in (0, 10]");
-  if (tube_shape && tube_shape->branches.size() != 1 && material == Material::kRubber) {
-    throw InvalidArgument("sim cell: tube_shape: " + std::to_string(tube_shape->branches.size()) +
-                          " branches; the simulated cell makes branched tubes of pvc (one rigid body) only, "
-                          "not rubber hose chains");
-  }
   if (tube_shape) tube_shape->Validate();
   scanner.Validate();
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 #include <string>
 
 #include "core/common/errors.h"
@@ -108,12 +110,6 @@ std::unique_ptr<btGeneric6DofSpring2Constraint> MakeJoint(btRigidBody& a, btRigi
 /// A branched pvc tube: one rigid compound of its whole tree; its geometry kept in the body frame.
 SimTube AddRigidTree(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin,
                      std::size_t tube_index, const TubeBodyOptions& options, SimTube tube) {
-  if (options.rubber) {
-    throw InvalidArgument(
-        "sim cell: tube " + std::to_string(tube_Bin.id) +
-        " is branched; the simulated cell makes branched tubes of pvc (one rigid body) only, "
-        "not rubber hose chains");
-  }
   const BodyShape shape = CompoundShape(world, physics::MakeTubeSegments(tube_Bin.ToTube(), 0.001),
                                         options.mass, options.collision_margin);
   SimLink link;
@@ -122,6 +118,170 @@ SimTube AddRigidTree(physics::BulletWorld& world, const physics::TubeGeometry& t
   tube.links.push_back(std::move(link));
   tube.tree_C = tube_Bin.Transformed(shape.X_BinC.inverse());
   return tube;
+}
+
+/// A branch of a tree: the chain of edges from one end or junction node to the next, as node ids.
+struct TreeBranch {
+  std::vector<int> nodes;
+};
+
+/// The tree's branches, each walked from a node of degree other than 2 to the next.
+std::vector<TreeBranch> TreeBranches(const physics::TubeGeometry& tree) {
+  std::map<int, std::vector<std::pair<int, std::size_t>>> next;  // node -> (neighbour, edge)
+  for (std::size_t e = 0; e < tree.edges.size(); ++e) {
+    next[tree.edges[e].node1].emplace_back(tree.edges[e].node2, e);
+    next[tree.edges[e].node2].emplace_back(tree.edges[e].node1, e);
+  }
+  std::vector<char> walked(tree.edges.size(), 0);
+  std::vector<TreeBranch> out;
+  for (const auto& [start, around] : next) {
+    if (around.size() == 2) continue;
+    for (const auto& [first, first_edge] : around) {
+      if (walked[first_edge] != 0) continue;
+      TreeBranch branch{{start}};
+      int at = first;
+      std::size_t edge = first_edge;
+      while (true) {
+        walked[edge] = 1;
+        branch.nodes.push_back(at);
+        const auto& here = next.at(at);
+        if (here.size() != 2) break;
+        const auto& onward = here[0].second == edge ? here[1] : here[0];
+        at = onward.first;
+        edge = onward.second;
+      }
+      out.push_back(std::move(branch));
+    }
+  }
+  return out;
+}
+
+/// Ignores collisions between links that share a node or a neighbour: at a joint or a junction
+/// their capsules overlap by construction.
+void IgnoreNearLinks(SimTube& tube) {
+  std::map<int, std::vector<std::size_t>> at_node;
+  for (std::size_t l = 0; l < tube.link_nodes.size(); ++l) {
+    at_node[tube.link_nodes[l].first].push_back(l);
+    at_node[tube.link_nodes[l].second].push_back(l);
+  }
+  const auto neighbours = [&](std::size_t l) {
+    std::set<std::size_t> out;
+    for (const int node : {tube.link_nodes[l].first, tube.link_nodes[l].second}) {
+      for (const std::size_t k : at_node[node]) out.insert(k);
+    }
+    return out;
+  };
+  for (std::size_t l = 0; l < tube.links.size(); ++l) {
+    std::set<std::size_t> near;
+    for (const std::size_t k : neighbours(l)) {
+      for (const std::size_t j : neighbours(k)) near.insert(j);
+    }
+    for (const std::size_t j : near) {
+      if (j != l) tube.links[l].body->setIgnoreCollisionCheck(tube.links[j].body, true);
+    }
+  }
+}
+
+/// A branched rubber tube: a chain of links per branch, the branches held together at each
+/// junction by joints to one of the links that meet there.
+SimTube AddRubberTree(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin,
+                      std::size_t tube_index, const TubeBodyOptions& options, SimTube tube) {
+  const std::vector<TreeBranch> branches = TreeBranches(tube_Bin);
+  const double total = tube_Bin.Length();
+  int next_id = 0;
+  for (const physics::TubeNode& n : tube_Bin.nodes) next_id = std::max(next_id, n.id + 1);
+  struct Piece {
+    std::size_t link;
+    Eigen::Vector3d p_node, away;  // the link's end at the node, and its direction from there
+    double length;
+  };
+  std::map<int, std::vector<Piece>> at_junction;
+  for (const TreeBranch& branch : branches) {
+    std::vector<Eigen::Vector3d> line;
+    for (const int id : branch.nodes) line.push_back(tube_Bin.Node(id).centre);
+    double length = 0.0;
+    for (std::size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
+    const int links = std::max(1, static_cast<int>(std::lround(length / options.material.link_length)));
+    const std::vector<Eigen::Vector3d> points = ResamplePolyline(line, links + 1);
+    const bool free_front = tube_Bin.Degree(branch.nodes.front()) == 1;
+    const bool free_back = tube_Bin.Degree(branch.nodes.back()) == 1;
+    const std::size_t first = tube.links.size();
+    for (int j = 0; j < links; ++j) {
+      physics::TubeSegment seg;
+      seg.a = points[j];
+      seg.b = points[j + 1];
+      seg.radius = tube.radius;
+      seg.sphere_a = j > 0 || !free_front;  // free ends are flat, junctions round
+      seg.sphere_b = j + 1 < links || !free_back;
+      const double mass = options.mass * (seg.b - seg.a).norm() / total;
+      const BodyShape shape = CompoundShape(world, {seg}, mass, options.collision_margin);
+      SimLink link;
+      link.p_C_points = ToBodyFrame(shape, {seg.a, seg.b});
+      link.mass = mass;
+      link.body = AddBody(world, shape, mass, options, tube_index, static_cast<int>(tube.links.size()));
+      tube.links.push_back(std::move(link));
+      const int a = j == 0 ? branch.nodes.front() : next_id - 1;
+      const int b = j + 1 == links ? branch.nodes.back() : next_id++;
+      tube.link_nodes.emplace_back(a, b);
+    }
+    for (int j = 1; j < links; ++j) {
+      const SimLink& la = tube.links[first + j - 1];
+      const SimLink& lb = tube.links[first + j];
+      tube.joints.push_back(MakeJoint(*la.body, *lb.body, points[j], points[j + 1] - points[j],
+                                      (points[j] - points[j - 1]).norm(), (points[j + 1] - points[j]).norm(),
+                                      la.mass, lb.mass, options.material, options.time_step));
+      world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+    }
+    if (!free_front) {
+      at_junction[branch.nodes.front()].push_back(
+          {first, points[0], points[1] - points[0], (points[1] - points[0]).norm()});
+    }
+    if (!free_back) {
+      at_junction[branch.nodes.back()].push_back({tube.links.size() - 1, points[links],
+                                                  points[links - 1] - points[links],
+                                                  (points[links] - points[links - 1]).norm()});
+    }
+  }
+  for (const auto& [node, pieces] : at_junction) {
+    const Piece& hub = pieces.front();
+    for (std::size_t k = 1; k < pieces.size(); ++k) {
+      const Piece& other = pieces[k];
+      tube.joints.push_back(MakeJoint(*tube.links[hub.link].body, *tube.links[other.link].body, other.p_node,
+                                      other.away, hub.length, other.length, tube.links[hub.link].mass,
+                                      tube.links[other.link].mass, options.material, options.time_step));
+      world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+    }
+  }
+  IgnoreNearLinks(tube);
+  return tube;
+}
+
+/// The branched rubber tube as it is now (CurrentGeometry).
+physics::TubeGeometry CurrentTree(const SimTube& tube) {
+  std::map<int, std::pair<Eigen::Vector3d, int>> sum;  // node -> (sum of positions, count)
+  for (std::size_t l = 0; l < tube.links.size(); ++l) {
+    const Eigen::Isometry3d X_BinC = FromBt(tube.links[l].body->getWorldTransform());
+    for (const auto& [node, p_C] : {std::pair{tube.link_nodes[l].first, tube.links[l].p_C_points.front()},
+                                    std::pair{tube.link_nodes[l].second, tube.links[l].p_C_points.back()}}) {
+      auto& [p, n] = sum.try_emplace(node, Eigen::Vector3d::Zero(), 0).first->second;
+      p += X_BinC * p_C;
+      ++n;
+    }
+  }
+  physics::TubeGeometry g;
+  g.id = tube.id;
+  for (const auto& [node, pn] : sum) g.nodes.push_back({node, pn.first / pn.second, tube.radius});
+  for (std::size_t l = 0; l < tube.links.size(); ++l) {
+    physics::TubeEdge e;
+    e.node1 = tube.link_nodes[l].first;
+    e.node2 = tube.link_nodes[l].second;
+    e.name = "e_" + std::to_string(e.node1) + "_" + std::to_string(e.node2);
+    e.order = static_cast<int>(l + 1);
+    e.radius = tube.radius;
+    physics::SetEdgeFromNodes(g, e);
+    g.edges.push_back(e);
+  }
+  return g;
 }
 
 }  // namespace
@@ -156,7 +316,10 @@ SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tub
   tube.id = tube_Bin.id;
   tube.radius = tube_Bin.edges.front().radius;
   tube.mass = options.mass;
-  if (!tube_Bin.IsLinear()) return AddRigidTree(world, tube_Bin, tube_index, options, std::move(tube));
+  if (!tube_Bin.IsLinear()) {
+    return options.rubber ? AddRubberTree(world, tube_Bin, tube_index, options, std::move(tube))
+                          : AddRigidTree(world, tube_Bin, tube_index, options, std::move(tube));
+  }
   const std::vector<Eigen::Vector3d> line = tube_Bin.Centreline();
 
   if (!options.rubber) {
@@ -213,6 +376,7 @@ SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tub
 
 physics::TubeGeometry CurrentGeometry(const SimTube& tube) {
   if (tube.tree_C) return tube.tree_C->Transformed(FromBt(tube.links.front().body->getWorldTransform()));
+  if (!tube.link_nodes.empty()) return CurrentTree(tube);
   std::vector<Eigen::Vector3d> points;
   for (std::size_t l = 0; l < tube.links.size(); ++l) {
     const SimLink& link = tube.links[l];

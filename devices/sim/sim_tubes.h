@@ -34,8 +34,11 @@ struct SimTube {
   double mass = 0.0;
   std::vector<SimLink> links;
   std::vector<std::unique_ptr<btGeneric6DofSpring2Constraint>> joints;
-  /// A branched (pvc) tube: its tree in the frame C of its one body.
+  /// A branched pvc tube: its tree in the frame C of its one body.
   std::optional<physics::TubeGeometry> tree_C;
+  /// A branched rubber tube: the node ids of each link's two centreline points (links[l].p_C_points
+  /// front and back); links meeting at a node share its id, a junction's three links one id.
+  std::vector<std::pair<int, int>> link_nodes;
 };
 
 /// How tube bodies are made.
@@ -57,20 +60,22 @@ struct TubeBodyOptions {
 };
 
 /// Adds `tube_Bin` (bin frame) to `world` where it is: one rigid capsule compound (pvc, linear or
-/// branched,
-/// physics::MakeTubeShape) or a chain of capsule links joined at the centreline by
+/// branched, physics::MakeTubeShape) or a chain of capsule links joined at the centreline by
 /// btGeneric6DofSpring2Constraints (rubber: locked translation and twist, implicit angular springs
-/// about both bending axes whose rest angle is the generated shape).
-/// Links within two of each other do not collide. Every body's user index is `tube_index` and user
-/// index 2 its link index.
-/// @throws InvalidArgument when the tube has no length, or is branched and rubber.
+/// about both bending axes whose rest angle is the generated shape). A branched rubber tube is a
+/// chain per branch (between its end and junction nodes); at a junction one of the branches'
+/// links holds the others by such joints, so the fitting keeps its angles as a spring.
+/// Links within two of each other (through shared nodes) do not collide. Every body's user index
+/// is `tube_index` and user index 2 its link index.
+/// @throws InvalidArgument when the tube has no length.
 SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin, std::size_t tube_index,
                    const TubeBodyOptions& options);
 
-/// The tube as it is now, bin frame: a branched tube's tree moved with its body; a linear tube's
-/// centreline points as nodes (ids 1..n, in order; a joint
-/// shared by two links is the mean of both), an edge between consecutive nodes ("e_<i>_<i+1>",
-/// order i, the tube's radius).
+/// The tube as it is now, bin frame: a branched pvc tube's tree moved with its body; a linear
+/// tube's centreline points as nodes (ids 1..n, in order; a joint shared by two links is the mean
+/// of both), an edge between consecutive nodes ("e_<i>_<i+1>", order i, the tube's radius); a
+/// branched rubber tube's link ends as nodes (a node shared by links is their mean), an edge per
+/// link.
 physics::TubeGeometry CurrentGeometry(const SimTube& tube);
 
 /// Mass-weighted centre of the tube's bodies, bin frame.

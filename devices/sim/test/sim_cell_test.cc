@@ -75,7 +75,7 @@ TEST(SimCell, ConstructionDropsEveryTubeIntoTheBin) {
   }
 }
 
-TEST(SimCell, BranchedPvcTreesAreRigidBodiesThatKeepTheirShape) {
+TEST(SimCell, BranchedTreesAreRigidInPvcAndJointedChainsInRubber) {
   SimCellParams params = SimCellParams::Thesis(Material::kPvc, 3, 5);
   params.tube_shape = physics::RandomTubeParams::SetC();
   params.tube_shape->radius = params.cell.tube.radius;
@@ -102,13 +102,29 @@ TEST(SimCell, BranchedPvcTreesAreRigidBodiesThatKeepTheirShape) {
     }
   }
 
-  // Rubber trees are refused, naming what is missing.
+  // Rubber trees: a chain of links per branch, held at the junctions by spring joints. They keep
+  // their topology and their length, and the joints hold (every link keeps its length as the
+  // tree settles and bends).
   params.material = Material::kRubber;
-  try {
-    SimCell rubber(params);
-    FAIL() << "expected InvalidArgument";
-  } catch (const InvalidArgument& e) {
-    EXPECT_THAT(e.what(), HasSubstr("branched tubes of pvc (one rigid body) only"));
+  SimCell rubber(params);
+  EXPECT_EQ(rubber.TubesInBin(), 3u);
+  const std::vector<physics::TubeGeometry> hoses = rubber.TubesBin();
+  ASSERT_EQ(hoses.size(), 3u);
+  for (const physics::TubeGeometry& tree : hoses) {
+    EXPECT_FALSE(tree.IsLinear());
+    const Tube core = tree.ToTube();
+    ASSERT_TRUE(core.branched());
+    EXPECT_EQ(core.nodes.size(), 6u);        // four free ends, two junctions
+    EXPECT_NEAR(core.length(), 0.75, 0.03);  // link chords are a little shorter than the arcs
+  }
+  (void)rubber.scanner().Scan(kLong);
+  rubber.Advance(1.0);
+  const std::vector<physics::TubeGeometry> later = rubber.TubesBin();
+  for (std::size_t t = 0; t < hoses.size(); ++t) {
+    ASSERT_EQ(later[t].edges.size(), hoses[t].edges.size());
+    for (std::size_t e = 0; e < hoses[t].edges.size(); ++e) {
+      EXPECT_NEAR(later[t].edges[e].length, hoses[t].edges[e].length, 0.003) << "tree " << t << " link " << e;
+    }
   }
 }
 
