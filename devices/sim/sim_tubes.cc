@@ -256,6 +256,18 @@ SimTube AddRubberTree(physics::BulletWorld& world, const physics::TubeGeometry& 
   return tube;
 }
 
+/// Appends the edge node1 → node2 ("e_<node1>_<node2>") to g, whose nodes hold both.
+void AddEdge(int node1, int node2, int order, double radius, physics::TubeGeometry* g) {
+  physics::TubeEdge e;
+  e.node1 = node1;
+  e.node2 = node2;
+  e.name = "e_" + std::to_string(node1) + "_" + std::to_string(node2);
+  e.order = order;
+  e.radius = radius;
+  physics::SetEdgeFromNodes(*g, e);
+  g->edges.push_back(e);
+}
+
 /// The branched rubber tube as it is now (CurrentGeometry).
 physics::TubeGeometry CurrentTree(const SimTube& tube) {
   std::map<int, std::pair<Eigen::Vector3d, int>> sum;  // node -> (sum of positions, count)
@@ -272,14 +284,7 @@ physics::TubeGeometry CurrentTree(const SimTube& tube) {
   g.id = tube.id;
   for (const auto& [node, pn] : sum) g.nodes.push_back({node, pn.first / pn.second, tube.radius});
   for (std::size_t l = 0; l < tube.links.size(); ++l) {
-    physics::TubeEdge e;
-    e.node1 = tube.link_nodes[l].first;
-    e.node2 = tube.link_nodes[l].second;
-    e.name = "e_" + std::to_string(e.node1) + "_" + std::to_string(e.node2);
-    e.order = static_cast<int>(l + 1);
-    e.radius = tube.radius;
-    physics::SetEdgeFromNodes(g, e);
-    g.edges.push_back(e);
+    AddEdge(tube.link_nodes[l].first, tube.link_nodes[l].second, static_cast<int>(l + 1), tube.radius, &g);
   }
   return g;
 }
@@ -396,14 +401,7 @@ physics::TubeGeometry CurrentGeometry(const SimTube& tube) {
     g.nodes.push_back({static_cast<int>(i + 1), points[i], tube.radius});
   }
   for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-    physics::TubeEdge e;
-    e.node1 = static_cast<int>(i + 1);
-    e.node2 = static_cast<int>(i + 2);
-    e.name = "e_" + std::to_string(e.node1) + "_" + std::to_string(e.node2);
-    e.order = static_cast<int>(i + 1);
-    e.radius = tube.radius;
-    physics::SetEdgeFromNodes(g, e);
-    g.edges.push_back(e);
+    AddEdge(static_cast<int>(i + 1), static_cast<int>(i + 2), static_cast<int>(i + 1), tube.radius, &g);
   }
   return g;
 }
