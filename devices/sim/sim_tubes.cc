@@ -120,6 +120,50 @@ SimTube AddRigidTree(physics::BulletWorld& world, const physics::TubeGeometry& t
   return tube;
 }
 
+/// Rubber: one link per pair of consecutive `points`, each of mass options.mass × its length /
+/// `chord_total`, joined in order by spring joints (MakeJoint); a free end is flat, the others
+/// round. Appends the links to `tube`; returns the index of the first.
+std::size_t AddLinkChain(physics::BulletWorld& world, const std::vector<Eigen::Vector3d>& points,
+                         bool free_front, bool free_back, double chord_total, std::size_t tube_index,
+                         const TubeBodyOptions& options, SimTube& tube) {
+  const std::size_t first = tube.links.size();
+  const std::size_t links = points.size() - 1;
+  for (std::size_t j = 0; j < links; ++j) {
+    physics::TubeSegment seg;
+    seg.a = points[j];
+    seg.b = points[j + 1];
+    seg.radius = tube.radius;
+    seg.sphere_a = j > 0 || !free_front;
+    seg.sphere_b = j + 1 < links || !free_back;
+    const double mass = options.mass * (seg.b - seg.a).norm() / chord_total;
+    // A one-child compound even for the inner links: bare capsules collide analytically but with a
+    // single contact point per pair, which let piles of hoses rock instead of coming to rest (a
+    // pick cycle cost 40 % more).
+    const BodyShape shape = CompoundShape(world, {seg}, mass, options.collision_margin);
+    SimLink link;
+    link.p_C_points = ToBodyFrame(shape, {seg.a, seg.b});
+    link.mass = mass;
+    link.body = AddBody(world, shape, mass, options, tube_index, static_cast<int>(tube.links.size()));
+    tube.links.push_back(std::move(link));
+  }
+  for (std::size_t j = 1; j < links; ++j) {
+    const SimLink& a = tube.links[first + j - 1];
+    const SimLink& b = tube.links[first + j];
+    tube.joints.push_back(MakeJoint(*a.body, *b.body, points[j], points[j + 1] - points[j],
+                                    (points[j] - points[j - 1]).norm(), (points[j + 1] - points[j]).norm(),
+                                    a.mass, b.mass, options.material, options.time_step));
+    world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+  }
+  return first;
+}
+
+/// The summed lengths of consecutive points' segments.
+double ChordLength(const std::vector<Eigen::Vector3d>& points) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
+  return length;
+}
+
 /// A branch of a tree: the chain of edges from one end or junction node to the next, as node ids.
 struct TreeBranch {
   std::vector<int> nodes;
@@ -187,7 +231,17 @@ void IgnoreNearLinks(SimTube& tube) {
 SimTube AddRubberTree(physics::BulletWorld& world, const physics::TubeGeometry& tube_Bin,
                       std::size_t tube_index, const TubeBodyOptions& options, SimTube tube) {
   const std::vector<TreeBranch> branches = TreeBranches(tube_Bin);
-  const double total = tube_Bin.Length();
+  // Each branch's link ends along its centreline; link masses share the tube's mass by length.
+  std::vector<std::vector<Eigen::Vector3d>> branch_points;
+  double chord_total = 0.0;
+  for (const TreeBranch& branch : branches) {
+    std::vector<Eigen::Vector3d> line;
+    for (const int id : branch.nodes) line.push_back(tube_Bin.Node(id).centre);
+    const int links =
+        std::max(1, static_cast<int>(std::lround(ChordLength(line) / options.material.link_length)));
+    branch_points.push_back(ResamplePolyline(line, links + 1));
+    chord_total += ChordLength(branch_points.back());
+  }
   int next_id = 0;
   for (const physics::TubeNode& n : tube_Bin.nodes) next_id = std::max(next_id, n.id + 1);
   struct Piece {
@@ -196,50 +250,27 @@ SimTube AddRubberTree(physics::BulletWorld& world, const physics::TubeGeometry& 
     double length;
   };
   std::map<int, std::vector<Piece>> at_junction;
-  for (const TreeBranch& branch : branches) {
-    std::vector<Eigen::Vector3d> line;
-    for (const int id : branch.nodes) line.push_back(tube_Bin.Node(id).centre);
-    double length = 0.0;
-    for (std::size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
-    const int links = std::max(1, static_cast<int>(std::lround(length / options.material.link_length)));
-    const std::vector<Eigen::Vector3d> points = ResamplePolyline(line, links + 1);
-    const bool free_front = tube_Bin.Degree(branch.nodes.front()) == 1;
-    const bool free_back = tube_Bin.Degree(branch.nodes.back()) == 1;
-    const std::size_t first = tube.links.size();
-    for (int j = 0; j < links; ++j) {
-      physics::TubeSegment seg;
-      seg.a = points[j];
-      seg.b = points[j + 1];
-      seg.radius = tube.radius;
-      seg.sphere_a = j > 0 || !free_front;  // free ends are flat, junctions round
-      seg.sphere_b = j + 1 < links || !free_back;
-      const double mass = options.mass * (seg.b - seg.a).norm() / total;
-      const BodyShape shape = CompoundShape(world, {seg}, mass, options.collision_margin);
-      SimLink link;
-      link.p_C_points = ToBodyFrame(shape, {seg.a, seg.b});
-      link.mass = mass;
-      link.body = AddBody(world, shape, mass, options, tube_index, static_cast<int>(tube.links.size()));
-      tube.links.push_back(std::move(link));
-      const int a = j == 0 ? branch.nodes.front() : next_id - 1;
-      const int b = j + 1 == links ? branch.nodes.back() : next_id++;
-      tube.link_nodes.emplace_back(a, b);
-    }
-    for (int j = 1; j < links; ++j) {
-      const SimLink& la = tube.links[first + j - 1];
-      const SimLink& lb = tube.links[first + j];
-      tube.joints.push_back(MakeJoint(*la.body, *lb.body, points[j], points[j + 1] - points[j],
-                                      (points[j] - points[j - 1]).norm(), (points[j + 1] - points[j]).norm(),
-                                      la.mass, lb.mass, options.material, options.time_step));
-      world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
+  for (std::size_t b = 0; b < branches.size(); ++b) {
+    const std::vector<int>& nodes = branches[b].nodes;
+    const std::vector<Eigen::Vector3d>& points = branch_points[b];
+    const std::size_t links = points.size() - 1;
+    const bool free_front = tube_Bin.Degree(nodes.front()) == 1;
+    const bool free_back = tube_Bin.Degree(nodes.back()) == 1;
+    const std::size_t first =
+        AddLinkChain(world, points, free_front, free_back, chord_total, tube_index, options, tube);
+    for (std::size_t j = 0; j < links; ++j) {
+      const int a = j == 0 ? nodes.front() : next_id - 1;
+      const int z = j + 1 == links ? nodes.back() : next_id++;
+      tube.link_nodes.emplace_back(a, z);
     }
     if (!free_front) {
-      at_junction[branch.nodes.front()].push_back(
+      at_junction[nodes.front()].push_back(
           {first, points[0], points[1] - points[0], (points[1] - points[0]).norm()});
     }
     if (!free_back) {
-      at_junction[branch.nodes.back()].push_back({tube.links.size() - 1, points[links],
-                                                  points[links - 1] - points[links],
-                                                  (points[links] - points[links - 1]).norm()});
+      at_junction[nodes.back()].push_back({first + links - 1, points[links],
+                                           points[links - 1] - points[links],
+                                           (points[links] - points[links - 1]).norm()});
     }
   }
   for (const auto& [node, pieces] : at_junction) {
@@ -340,36 +371,8 @@ SimTube AddSimTube(physics::BulletWorld& world, const physics::TubeGeometry& tub
 
   const int links = std::max(2, static_cast<int>(std::lround(length / options.material.link_length)));
   const std::vector<Eigen::Vector3d> points = ResamplePolyline(line, links + 1);
-  std::vector<double> lengths;
-  double chord_sum = 0.0;
-  for (int j = 0; j < links; ++j) {
-    lengths.push_back((points[j + 1] - points[j]).norm());
-    chord_sum += lengths.back();
-  }
-  for (int j = 0; j < links; ++j) {
-    physics::TubeSegment seg;
-    seg.a = points[j];
-    seg.b = points[j + 1];
-    seg.radius = tube.radius;
-    seg.sphere_a = j > 0;  // the tube's free ends are flat
-    seg.sphere_b = j + 1 < links;
-    const double mass = options.mass * lengths[j] / chord_sum;
-    // A one-child compound even for the inner links: bare capsules collide analytically but with a
-    // single contact point per pair, which let piles of hoses rock instead of coming to rest (a
-    // pick cycle cost 40 % more).
-    const BodyShape shape = CompoundShape(world, {seg}, mass, options.collision_margin);
-    SimLink link;
-    link.p_C_points = ToBodyFrame(shape, {seg.a, seg.b});
-    link.mass = mass;
-    link.body = AddBody(world, shape, mass, options, tube_index, j);
-    tube.links.push_back(std::move(link));
-  }
-  for (int j = 1; j < links; ++j) {
-    tube.joints.push_back(MakeJoint(
-        *tube.links[j - 1].body, *tube.links[j].body, points[j], points[j + 1] - points[j], lengths[j - 1],
-        lengths[j], tube.links[j - 1].mass, tube.links[j].mass, options.material, options.time_step));
-    world.world->addConstraint(tube.joints.back().get(), /*disableCollisionsBetweenLinkedBodies=*/true);
-  }
+  AddLinkChain(world, points, /*free_front=*/true, /*free_back=*/true, ChordLength(points), tube_index,
+               options, tube);
   // Links two apart may overlap at a sharp bend of the rest shape; farther ones cannot (Algorithm
   // 2 rejects self-intersecting tubes).
   for (int j = 2; j < links; ++j) {

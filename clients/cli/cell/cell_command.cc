@@ -414,7 +414,8 @@ void AddCellCommand(CLI::App& app) {
   cmd->add_option(
          "--shapes", o->shapes,
          "Tube shapes of the simulated bins: A (20° bends), B (45°), C (branched trees, as published: "
-         "branches in random directions) or CY (trees with Y-pieces, arms 120° apart); trees are rigid in pvc and jointed link chains in rubber; "
+         "branches in random directions) or CY (trees with Y-pieces, arms 120° apart); trees are rigid in "
+         "pvc and jointed link chains in rubber; "
          "default: A for pvc, B for rubber")
       ->check(CLI::IsMember({"A", "B", "C", "CY"}));
   cmd->add_option("--server", o->server,
