@@ -5,6 +5,7 @@
 
 #include "clients/cli/cell/cell_command.h"
 #include "clients/cli/cell/devices_check.h"
+#include "clients/cli/cell/resolution_trials.h"
 #include "clients/cli/cell/virtual_cell.h"
 #include "clients/cli/eval/eval_command.h"
 #include "clients/cli/load/bench_service.h"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   tubepick::cli::AddCellCommand(app);
   tubepick::cli::AddDevicesCommand(app);
   tubepick::cli::AddVirtualCellCommand(app);
+  tubepick::cli::AddResolutionTrialsCommand(app);
   tubepick::cli::AddLoadCommand(app);
   tubepick::cli::AddHealthCommand(app);
   tubepick::cli::AddRequestCommand(app);

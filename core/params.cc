@@ -80,6 +80,11 @@ Params ProfileParams(const std::string& name) {
   Params p;
   if (name == "fast") {
     p.modeling = FastModelingProfile();
+    // The thesis' 45° left rubber hoses hanging (§5.3.4: friction too high; tan 45° = 1 is the
+    // rubber's μ); 55° frees more and stays within the arm's 60° tilt. On the same 33 double picks
+    // of generated set-C pvc bins, carried over the bin's middle first, 55° freed 19 and 45° 13
+    // (`tubepick resolution-trials`, docs/ACCURACY.md).
+    p.wrench.rotation_angle = 55.0 * M_PI / 180.0;
   } else if (name == "thesis") {
     p.modeling = ThesisModelingProfile();
   } else {

@@ -11,6 +11,7 @@
 #include "clients/cell/cell_frame_check.h"
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
+#include "core/wrench/resolution_hold.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::cell {
@@ -120,9 +121,10 @@ void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& at
   try {
     const Eigen::Isometry3d X_BinTcpLift = Lift(poses.waypoints_Bin, attempt);
     CheckStillHolding("lift", attempt);
-    const v1::AnalyzeWrenchResponse analysis = AnalyzeLift(reference, X_BinTcpLift, attempt);
+    devices::WrenchReading lifted;
+    const v1::AnalyzeWrenchResponse analysis = AnalyzeLift(reference, X_BinTcpLift, attempt, &lifted);
     attempt.result = Conclude(analysis.outcome(), poses.X_BinTcpPlace, reference, attempt);
-    if (!attempt.result) attempt.result = Resolve(analysis, reference, poses, X_BinTcpLift, attempt);
+    if (!attempt.result) attempt.result = Resolve(analysis, reference, lifted, poses, X_BinTcpLift, attempt);
   } catch (const TubeLost& lost) {
     RecordLost(lost, attempt);
     attempt.result = AttemptResult::kLost;
@@ -177,14 +179,14 @@ Eigen::Isometry3d CellController::Lift(const std::vector<Eigen::Vector3d>& waypo
 
 /// A reading at the lift pose and its analysis against the reference.
 v1::AnalyzeWrenchResponse CellController::AnalyzeLift(const devices::WrenchReading& reference,
-                                                      const Eigen::Isometry3d& X_BinTcpLift,
-                                                      Attempt& attempt) {
+                                                      const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt,
+                                                      devices::WrenchReading* lifted) {
   Enter(CellState::kAnalyze);
   nlohmann::json& record = attempt.record;
-  const devices::WrenchReading lifted = ReadWrench();
-  record["wrench"]["lift"] = WrenchJson(lifted);
+  *lifted = ReadWrench();
+  record["wrench"]["lift"] = WrenchJson(*lifted);
   record["wrench"]["after_resolution"] = nlohmann::json::array();
-  const v1::AnalyzeWrenchResponse analysis = Analyze(reference, lifted, X_BinTcpLift, attempt);
+  const v1::AnalyzeWrenchResponse analysis = Analyze(reference, *lifted, X_BinTcpLift, attempt);
   record["analysis"] = AnalysisJson(analysis);
   record["resolution"] = ResolutionJson(analysis.resolution_motions_size());
   return analysis;
@@ -206,41 +208,60 @@ std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOu
   }
 }
 
-/// Several tubes: resolution motions in order, each followed by a new reading at the lift pose.
+/// Several tubes: carried over the bin's middle (resolution_hold_over_bin), then the resolution
+/// motions in order there, each followed by a new reading at the hold pose; unresolved, back to the
+/// lift pose and put back.
 CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchResponse& analysis,
                                                       const devices::WrenchReading& reference,
+                                                      const devices::WrenchReading& lifted,
                                                       const PlanPoses& poses,
                                                       const Eigen::Isometry3d& X_BinTcpLift,
                                                       Attempt& attempt) {
   Enter(CellState::kResolve);
   nlohmann::json& resolution = attempt.record["resolution"];
+  Eigen::Vector3d shift_Bin = Eigen::Vector3d::Zero();
+  if (params_.resolution_hold_over_bin && analysis.resolution_motions_size() > 0) {
+    const ResolutionHold hold =
+        PlanResolutionHold(Wrench{reference.force, reference.torque}, Wrench{lifted.force, lifted.torque},
+                           X_BinTcpLift, cell_.bin.inner_size, params_.resolution_wall_margin);
+    shift_Bin = hold.shift_Bin;
+    resolution["payload_offset"] = {hold.p_TcpPayload_Bin.x(), hold.p_TcpPayload_Bin.y()};
+  }
+  resolution["hold_shift"] = {shift_Bin.x(), shift_Bin.y()};
+  const Eigen::Translation3d shift(shift_Bin);
+  const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
+  if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
     resolution["used"] = m + 1;
     const v1::AnalyzeWrenchResponse again =
-        ResolutionMotion(analysis.resolution_motions(m), m, reference, X_BinTcpLift, attempt);
+        ResolutionMotion(analysis.resolution_motions(m), m, reference, shift, X_BinTcpHold, attempt);
     if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
             Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))
       return *result;
   }
+  if (!shift_Bin.isZero()) MoveTo(X_BinTcpLift, params_.lift_speed, &attempt);
   PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, attempt);
   return AttemptResult::kMultipleReturned;
 }
 
 v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                                            const devices::WrenchReading& reference,
-                                                           const Eigen::Isometry3d& X_BinTcpLift,
+                                                           const Eigen::Translation3d& shift,
+                                                           const Eigen::Isometry3d& X_BinTcpHold,
                                                            Attempt& attempt) {
+  // The planner's waypoints turn about the TCP at the lift pose; the same turns about the TCP at
+  // the hold pose are the waypoints moved by the hold's shift.
   for (int w = 0; w < motion.waypoints_size(); ++w) {
     const Eigen::Isometry3d X_BinTcpWaypoint =
-        PlannerPose(motion.waypoints(w).tcp_pose(),
-                    fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
+        shift * PlannerPose(motion.waypoints(w).tcp_pose(),
+                            fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
     MoveTo(X_BinTcpWaypoint, params_.resolution_speed, &attempt);
   }
-  MoveTo(X_BinTcpLift, params_.resolution_speed, &attempt);
+  MoveTo(X_BinTcpHold, params_.resolution_speed, &attempt);
   CheckStillHolding("resolve", attempt);
   const devices::WrenchReading after = ReadWrench();
-  const v1::AnalyzeWrenchResponse again = Analyze(reference, after, X_BinTcpLift, attempt);
+  const v1::AnalyzeWrenchResponse again = Analyze(reference, after, X_BinTcpHold, attempt);
   attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, after, again));
   return again;
 }

@@ -349,17 +349,22 @@ class CellController {
   void ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpPreGrasp, Attempt& attempt);
   /// Along the plan's waypoints; returns the lift pose.
   Eigen::Isometry3d Lift(const std::vector<Eigen::Vector3d>& waypoints_Bin, Attempt& attempt);
+  /// The reading at the lift pose (into `lifted`) and its analysis.
   v1::AnalyzeWrenchResponse AnalyzeLift(const devices::WrenchReading& reference,
-                                        const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+                                        const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt,
+                                        devices::WrenchReading* lifted);
   /// SINGLE: place; NONE: release; MULTIPLE: nullopt (resolve).
   std::optional<AttemptResult> Conclude(v1::HeldOutcome outcome, const Eigen::Isometry3d& X_BinTcpPlace,
                                         const devices::WrenchReading& reference, Attempt& attempt);
   AttemptResult Resolve(const v1::AnalyzeWrenchResponse& analysis, const devices::WrenchReading& reference,
-                        const PlanPoses& poses, const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
-  /// Resolution motion `m`, back to the lift pose, a new reading and its analysis.
+                        const devices::WrenchReading& lifted, const PlanPoses& poses,
+                        const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+  /// Resolution motion `m` moved by `shift` (lift pose → hold pose), back to the hold pose, a new
+  /// reading and its analysis.
   v1::AnalyzeWrenchResponse ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                              const devices::WrenchReading& reference,
-                                             const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
+                                             const Eigen::Translation3d& shift,
+                                             const Eigen::Isometry3d& X_BinTcpHold, Attempt& attempt);
   void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
              Attempt& attempt);
   /// The gripper still reports the object (Robotiq gOBJ 2); throws TubeLost naming `where` if not.

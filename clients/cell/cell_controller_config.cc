@@ -92,6 +92,9 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("approach_speed", p.approach_speed, "m/s, pre-grasp -> grasp, above place -> place");
   v("lift_speed", p.lift_speed, "m/s, along the plan's waypoints after the grasp");
   v("resolution_speed", p.resolution_speed, "m/s of the TCP, resolution rotations");
+  v("resolution_hold_over_bin", p.resolution_hold_over_bin,
+    "carry several tubes over the bin's middle before the resolution rotation");
+  v("resolution_wall_margin", p.resolution_wall_margin, "m, the TCP inside the bin walls while it does");
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");

@@ -49,6 +49,7 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(approach_speed, "approach_speed");
   RequirePositiveValue(lift_speed, "lift_speed");
   RequirePositiveValue(resolution_speed, "resolution_speed");
+  RequireNonNegativeValue(resolution_wall_margin, "resolution_wall_margin");
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");

@@ -32,6 +32,14 @@ struct CellControllerParams {
   double lift_speed = 0.1;
   /// Resolution rotations and the return to the lift pose, m/s of the TCP (the robot's speed unit).
   double resolution_speed = 0.1;
+  /// Several tubes held: before the resolution rotation, carry them (at lift_speed, at the lift
+  /// height) so that the payload's centre of mass, estimated from the torque (PlanResolutionHold),
+  /// is over the bin's middle, with the TCP at least resolution_wall_margin inside the inner walls;
+  /// the rotation then runs there, so that what it frees falls into the bin. Unresolved tubes are
+  /// carried back to the lift pose before they are put back. On generated set-C pvc bins
+  /// (`tubepick resolution-trials`) this halved the tubes that ended outside the bin.
+  bool resolution_hold_over_bin = true;
+  double resolution_wall_margin = 0.15;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.

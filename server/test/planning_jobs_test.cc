@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "core/common/errors.h"
+#include "core/params.h"
 #include "core/testing/sanitizer_build.h"
 #include "core/testing/synthetic_cloud.h"
 #include "wire/packed_cloud.h"
@@ -380,15 +381,17 @@ TEST(RunAnalyzeWrench, ThreeTubesGiveARotationAboutTheTcp) {
   const v1::ResolutionMotion& m = r.resolution_motions(0);
   const Eigen::Vector3d axis(0.8, -0.6, 0.0);
   EXPECT_LT((FromProto(m.axis_tcp()) - axis).norm(), 1e-12);
-  EXPECT_NEAR(m.angle(), M_PI / 4, 1e-12);
+  const double angle = ProfileParams("fast").wrench.rotation_angle;  // the server's default profile
+  EXPECT_NEAR(angle, 55.0 * M_PI / 180.0, 1e-12);
+  EXPECT_NEAR(m.angle(), angle, 1e-12);
   EXPECT_EQ(m.yaw(), 0.0);
   EXPECT_FALSE(m.description().empty());
   ASSERT_EQ(m.waypoints_size(), 1);
   const v1::Pose& pose = m.waypoints(0).tcp_pose();
-  // A pure rotation about the TCP origin: the position stays, the orientation turns by 45° about
+  // A pure rotation about the TCP origin: the position stays, the orientation turns by 55° about
   // the torque axis of the lift-time TCP frame.
   EXPECT_LT((FromProto(pose.position()) - GraspTcp().translation()).norm(), 1e-12);
-  const Eigen::Matrix3d expected = GraspTcp().linear() * Eigen::AngleAxisd(M_PI / 4, axis).toRotationMatrix();
+  const Eigen::Matrix3d expected = GraspTcp().linear() * Eigen::AngleAxisd(angle, axis).toRotationMatrix();
   EXPECT_TRUE(FromProto(pose.orientation()).toRotationMatrix().isApprox(expected, 1e-12));
 }
 
@@ -397,8 +400,9 @@ TEST(RunAnalyzeWrench, VariantsOfTheRequestAreUsed) {
   const v1::AnalyzeWrenchResponse perpendicular =
       Analyze(WrenchRequest(2.0, delta, v1::RESOLUTION_VARIANT_PERPENDICULAR));
   ASSERT_EQ(perpendicular.resolution_motions_size(), 2);
-  EXPECT_NEAR(perpendicular.resolution_motions(0).angle(), M_PI / 4, 1e-12);
-  EXPECT_NEAR(perpendicular.resolution_motions(1).angle(), -M_PI / 4, 1e-12);
+  const double angle = ProfileParams("fast").wrench.rotation_angle;
+  EXPECT_NEAR(perpendicular.resolution_motions(0).angle(), angle, 1e-12);
+  EXPECT_NEAR(perpendicular.resolution_motions(1).angle(), -angle, 1e-12);
   // Perpendicular to ΔM (along y) and to the vertical: ±x.
   EXPECT_NEAR(std::abs(perpendicular.resolution_motions(0).axis_tcp().x()), 1.0, 1e-12);
 

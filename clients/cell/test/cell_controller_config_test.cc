@@ -19,6 +19,8 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.approach_speed, b.approach_speed);
   EXPECT_EQ(a.lift_speed, b.lift_speed);
   EXPECT_EQ(a.resolution_speed, b.resolution_speed);
+  EXPECT_EQ(a.resolution_hold_over_bin, b.resolution_hold_over_bin);
+  EXPECT_EQ(a.resolution_wall_margin, b.resolution_wall_margin);
   EXPECT_EQ(a.approach_height, b.approach_height);
   EXPECT_EQ(a.transit_clearance, b.transit_clearance);
   EXPECT_EQ(a.release_height, b.release_height);
@@ -122,6 +124,8 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   // Every other field off its default too, so a key the dump forgets fails the comparison.
   p.lift_speed = 0.11;
   p.resolution_speed = 0.12;
+  p.resolution_hold_over_bin = false;
+  p.resolution_wall_margin = 0.09;
   p.approach_height = 0.13;
   p.transit_clearance = 0.31;
   p.place_approach_height = 0.14;

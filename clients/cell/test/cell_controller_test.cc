@@ -7,6 +7,8 @@
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/test/scripted_cell.h"
 #include "core/common/errors.h"
+#include "core/wrench/resolution_hold.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::cell {
 namespace {
@@ -287,21 +289,35 @@ TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_SINGLE, 1.02)};
   ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(0.66)};
 
+  // The payload (1.2 N, its torque 0.03 / -0.01 N·m in the TCP axes) is first carried over the
+  // bin's middle: the rotation turns about the TCP there.
+  const ResolutionHold hold =
+      PlanResolutionHold(Wrench{Reading(0.1).force, Reading(0.1).torque},
+                         Wrench{Reading(1.3, 0.03, -0.01).force, Reading(1.3, 0.03, -0.01).torque},
+                         X_BinTcpLift, cell.bin.inner_size, params.resolution_wall_margin);
+  ASSERT_GT(hold.shift_Bin.norm(), 0.05);
+  const Eigen::Translation3d shift(hold.shift_Bin);
+
   const CellRunResult result = Run();
   EXPECT_EQ(result.picks, 1u) << result.message;
-  EXPECT_TRUE(robot.Visited(X_BinTcpTilted));
-  // After the rotation the TCP went back to the lift pose, then on to the place pose.
+  EXPECT_FALSE(robot.Visited(X_BinTcpTilted));
+  // Lift pose, hold pose, the rotation there, back to the hold pose, then on to the place pose.
   int tilted_index = -1;
   for (std::size_t i = 0; i < robot.moves.size(); ++i)
-    if (robot.moves[i].X_BinTcpTarget.isApprox(X_BinTcpTilted, kTol)) tilted_index = static_cast<int>(i);
-  ASSERT_GE(tilted_index, 0);
-  EXPECT_TRUE(robot.moves[tilted_index + 1].X_BinTcpTarget.isApprox(X_BinTcpLift, kTol));
+    if (robot.moves[i].X_BinTcpTarget.isApprox(shift * X_BinTcpTilted, kTol))
+      tilted_index = static_cast<int>(i);
+  ASSERT_GE(tilted_index, 1);
+  EXPECT_TRUE(robot.moves[tilted_index - 1].X_BinTcpTarget.isApprox(shift * X_BinTcpLift, kTol));
+  EXPECT_DOUBLE_EQ(robot.moves[tilted_index - 1].speed, params.lift_speed);
+  EXPECT_TRUE(robot.moves[tilted_index + 1].X_BinTcpTarget.isApprox(shift * X_BinTcpLift, kTol));
   EXPECT_DOUBLE_EQ(robot.moves[tilted_index].speed, params.resolution_speed);
   EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   // The second analysis used the same reference and the new reading at the lift pose.
   ASSERT_EQ(planner.wrench_requests.size(), 2u);
   EXPECT_DOUBLE_EQ(planner.wrench_requests[1].reference().force().z(), 0.1);
   EXPECT_DOUBLE_EQ(planner.wrench_requests[1].current().force().z(), 0.66);
+  EXPECT_TRUE(
+      FromProto(planner.wrench_requests[1].tcp_pose(), "tcp_pose").isApprox(shift * X_BinTcpLift, kTol));
 
   const json a = Records("attempt").at(0);
   EXPECT_EQ(a["trajectory_kind"], "escape");
@@ -310,10 +326,29 @@ TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   EXPECT_EQ(a["resolution"]["available"], 2);
   EXPECT_EQ(a["resolution"]["used"], 1);
   EXPECT_EQ(a["resolution"]["succeeded"], true);
+  EXPECT_NEAR(a["resolution"]["hold_shift"][0].get<double>(), hold.shift_Bin.x(), 1e-12);
+  EXPECT_NEAR(a["resolution"]["payload_offset"][1].get<double>(), hold.p_TcpPayload_Bin.y(), 1e-12);
   ASSERT_EQ(a["wrench"]["after_resolution"].size(), 1u);
   EXPECT_EQ(a["wrench"]["after_resolution"][0]["outcome"], "single");
   EXPECT_DOUBLE_EQ(a["wrench"]["lift"]["torque"][0].get<double>(), 0.03);
   EXPECT_EQ(a["result"], "picked");
+}
+
+TEST_F(CellControllerTest, WithoutTheHoldTheRotationTurnsAtTheLiftPose) {
+  params.resolution_hold_over_bin = false;
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
+  const Eigen::Isometry3d X_BinTcpTilted = X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY());
+  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
+  AddWaypoint(multiple, 0, X_BinTcpTilted);
+  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(0.66)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(X_BinTcpTilted));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["resolution"]["hold_shift"], json::array({0.0, 0.0}));
 }
 
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {

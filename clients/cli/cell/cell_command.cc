@@ -37,24 +37,6 @@ namespace {
 
 using nlohmann::json;
 
-/// --shapes: the bins' tubes follow this set's shapes (Algorithm 2 presets) with the cell's tube
-/// radius. A linear set keeps the cell's tube length; set C's trees are 0.75 m of tube (the cell's
-/// length, mass scaled with it, and topology branched, so that the planner joins junctions).
-void WithShapes(const std::string& set, devices::sim::SimCellParams* p) {
-  physics::RandomTubeParams shape = physics::RandomTubeParams::Preset(set);
-  shape.radius = p->cell.tube.radius;
-  if (shape.branches.size() == 1) {
-    if (p->cell.tube.length > 0.0) shape.branches.front().length = p->cell.tube.length;
-  } else {
-    const CellConfig tree = CellForPreset(p->cell, set);
-    if (p->cell.tube.length > 0.0) p->cell.tube.mass *= tree.tube.length / p->cell.tube.length;
-    p->cell.tube.length = tree.tube.length;
-    p->cell.tube.topology = tree.tube.topology;
-    p->cell.tube.junction_shape = tree.tube.junction_shape;
-  }
-  p->tube_shape = shape;
-}
-
 struct CellOptions {
   bool sim = false;
   std::uint32_t rounds = 1;

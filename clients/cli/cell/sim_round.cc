@@ -3,12 +3,30 @@
 #include <chrono>
 #include <optional>
 
+#include "clients/cli/inputs/sim_scene.h"
+#include "physics/random_tubes.h"
+
 namespace tubepick::cli {
 namespace {
 
 constexpr double kRestAfterRound = 2.0;  // simulated seconds
 
 }  // namespace
+
+void WithShapes(const std::string& set, devices::sim::SimCellParams* p) {
+  physics::RandomTubeParams shape = physics::RandomTubeParams::Preset(set);
+  shape.radius = p->cell.tube.radius;
+  if (shape.branches.size() == 1) {
+    if (p->cell.tube.length > 0.0) shape.branches.front().length = p->cell.tube.length;
+  } else {
+    const CellConfig tree = CellForPreset(p->cell, set);
+    if (p->cell.tube.length > 0.0) p->cell.tube.mass *= tree.tube.length / p->cell.tube.length;
+    p->cell.tube.length = tree.tube.length;
+    p->cell.tube.topology = tree.tube.topology;
+    p->cell.tube.junction_shape = tree.tube.junction_shape;
+  }
+  p->tube_shape = shape;
+}
 
 SimRoundResult RunSimRound(cell::PlannerClient& planner, const devices::sim::SimCellParams& sim_params,
                            const cell::CellControllerParams& params, std::uint32_t round,

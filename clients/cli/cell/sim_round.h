@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
@@ -10,6 +11,11 @@
 #include "devices/sim/sim_cell.h"
 
 namespace tubepick::cli {
+
+/// --shapes: the bins' tubes follow this set's shapes (Algorithm 2 presets) with the cell's tube
+/// radius. A linear set keeps the cell's tube length; set C's trees are 0.75 m of tube (the cell's
+/// length, mass scaled with it, and topology branched, so that the planner joins junctions).
+void WithShapes(const std::string& set, devices::sim::SimCellParams* p);
 
 /// One closed-loop round in the simulated cell.
 struct SimRoundResult {

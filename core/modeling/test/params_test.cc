@@ -40,6 +40,11 @@ TEST(Params, ThesisProfileHasTableValues) {
   EXPECT_EQ(std::get<StatisticalOutlierParams>(p.filters[6]).neighbours, 100u);
 }
 
+TEST(Params, TheResolutionRotatesTheThesis45DegreesOr55InTheFastProfile) {
+  EXPECT_NEAR(ProfileParams("thesis").wrench.rotation_angle, 45.0 * M_PI / 180.0, 1e-15);  // Table 5.3
+  EXPECT_NEAR(ProfileParams("fast").wrench.rotation_angle, 55.0 * M_PI / 180.0, 1e-15);
+}
+
 TEST(Params, DumpRoundTrips) {
   for (const auto& name : ProfileNames()) {
     const Params p = ProfileParams(name);

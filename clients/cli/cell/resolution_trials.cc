@@ -1,0 +1,415 @@
+// tubepick resolution-trials: the entanglement-resolution rotation (thesis §5.2.6) tried on many
+// double picks in the simulated cell, so that its variants and angle are chosen on a measured rate
+// rather than on the handful of double picks a cell round gives.
+
+#include "clients/cli/cell/resolution_trials.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "clients/cli/cell/sim_round.h"
+#include "clients/cli/inputs/cli_inputs.h"
+#include "core/common/errors.h"
+#include "core/planning/grasp_synthesis.h"
+#include "core/planning/plan_certainty.h"
+#include "core/wrench/held_count.h"
+#include "core/wrench/resolution_hold.h"
+#include "core/wrench/resolution_rotation.h"
+#include "devices/device_error.h"
+#include "wire/wrench_analysis.h"
+
+namespace tubepick::cli {
+namespace {
+
+using devices::sim::Material;
+using devices::sim::SimCell;
+using devices::sim::SimCellParams;
+
+constexpr double kDegree = M_PI / 180.0;
+constexpr devices::Timeout kLong{std::chrono::seconds(120)};
+// Speeds of the controller's defaults (cell_controller_params.h): approach, lift, resolution.
+constexpr double kApproachSpeed = 0.05;
+constexpr double kLiftSpeed = 0.1;
+constexpr double kResolutionSpeed = 0.1;
+constexpr double kTransitSpeed = 0.25;
+// The fingers' opening on the way down, metres (the grasped tube is 2.5 cm thick).
+constexpr double kTrialOpening = 0.045;
+
+Wrench ToWrench(const devices::WrenchReading& r) { return Wrench{r.force, r.torque}; }
+
+// Grasps: above, down, close (the fingers already open). False when the gripper closed on nothing.
+bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp) {
+  Eigen::Isometry3d above = X_BinTcpGrasp;
+  above.translation().z() += 0.10;
+  cell.robot().MoveTo(above, kTransitSpeed, kLong);
+  cell.robot().MoveTo(X_BinTcpGrasp, kApproachSpeed, kLong);
+  return cell.gripper().Close(0.05, 50.0, kLong).object == devices::GripperObject::kStoppedClosing;
+}
+
+// The resolution as the controller runs it: with hold_over_bin, first to the hold pose
+// (PlanResolutionHold) and every waypoint shifted with it; each motion followed by the return to the
+// hold pose and a reading, until the F/T says one tube (or none).
+void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
+             const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
+             ResolutionTrial& trial) {
+  const double tube_mass = cell.cell().tube.mass;
+  const Eigen::Translation3d shift(
+      tp.hold_over_bin
+          ? PlanResolutionHold(reference, lifted, X_BinTcpLift, cell.cell().bin.inner_size, tp.wall_margin)
+                .shift_Bin
+          : Eigen::Vector3d::Zero());
+  const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
+  trial.hold_shift = shift.translation().norm();
+  cell.robot().MoveTo(X_BinTcpHold, kLiftSpeed, kLong);
+  for (const ResolutionMotion& motion : plan.motions) {
+    ++trial.motions_used;
+    for (const ResolutionWaypoint& w : motion.waypoints)
+      cell.robot().MoveTo(shift * w.X_BinTcpRotated, kResolutionSpeed, kLong);
+    if (tp.dwell > 0.0) cell.Advance(tp.dwell);
+    cell.robot().MoveTo(X_BinTcpHold, kResolutionSpeed, kLong);
+    const HeldCount again =
+        CountHeldTubes(reference, ToWrench(cell.ft_sensor().Read(kLong)), tube_mass, params);
+    if (again.outcome != HeldOutcome::kMultiple) {
+      trial.freed = again.outcome == HeldOutcome::kSingle;
+      return;
+    }
+  }
+}
+
+// Tubes other than `tube` hanging clear of the floor: every node above two radii.
+std::uint32_t OthersLifted(const SimCell& cell, std::size_t tube) {
+  const std::vector<physics::TubeGeometry> tubes = cell.TubesBin();
+  std::uint32_t lifted = 0;
+  for (std::size_t t = 0; t < tubes.size(); ++t) {
+    if (t == tube) continue;
+    lifted += std::all_of(tubes[t].nodes.begin(), tubes[t].nodes.end(), [&](const physics::TubeNode& n) {
+      return n.centre.z() > 2.0 * cell.cell().tube.radius;
+    });
+  }
+  return lifted;
+}
+
+// One lift of the trial: grasp from 10 cm above (reference reading there), lift, read. With several
+// tubes, the resolution; otherwise the tube is put back (lowered to 3 cm above the grasp, opened)
+// for the next lift.
+void LiftAndResolve(SimCell& cell, const TrialGrasp& grasp, const WrenchParams& wrench, const TrialParams& tp,
+                    ResolutionTrial& trial) {
+  cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
+  Eigen::Isometry3d above = grasp.X_BinTcp;
+  above.translation().z() += 0.10;
+  cell.robot().MoveTo(above, kTransitSpeed, kLong);
+  cell.ft_sensor().Bias(kLong);
+  const Wrench reference = ToWrench(cell.ft_sensor().Read(kLong));
+  if (!Grasp(cell, grasp.X_BinTcp)) {
+    cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
+    cell.robot().MoveTo(above, kApproachSpeed, kLong);
+    return;
+  }
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, tp.lift)}, kLiftSpeed, kLong);
+  const Eigen::Isometry3d X_BinTcpLift = cell.X_BinTcp();
+  const WrenchParams at_lift = WrenchParamsAtPose(wrench, X_BinTcpLift);
+  const double mass = cell.cell().tube.mass;
+  const Wrench lifted = ToWrench(cell.ft_sensor().Read(kLong));
+  trial.multiple = CountHeldTubes(reference, lifted, mass, at_lift).outcome == HeldOutcome::kMultiple;
+  if (trial.multiple) {
+    trial.others_lifted = OthersLifted(cell, grasp.tube);
+    if (const std::optional<ResolutionPlan> plan =
+            PlanResolutionRotation(reference, lifted, X_BinTcpLift, at_lift))
+      Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift, tp, trial);
+    if (trial.freed) return;  // held: the freed tubes fell, counted at the end
+    cell.robot().MoveTo(X_BinTcpLift, kLiftSpeed, kLong);
+  }
+  // Put back, as the controller does with one tube here or several it could not free.
+  Eigen::Isometry3d release = grasp.X_BinTcp;
+  release.translation().z() += 0.03;
+  cell.robot().MoveTo(release, kLiftSpeed, kLong);
+  cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
+  cell.robot().MoveTo(above, kApproachSpeed, kLong);
+}
+
+// Ground truth at the end: 2 s of rest, then whether the tube is held and how many others lie
+// outside the bin.
+void RecordTruth(SimCell& cell, ResolutionTrial& trial) {
+  cell.Advance(2.0);
+  const std::vector<std::size_t> held = cell.HeldTubes();
+  trial.tube_held = std::find(held.begin(), held.end(), trial.tube) != held.end();
+  trial.others_outside = cell.TubesOutsideBin();
+}
+
+// Whether the open fingers (and the housing above them) coming down to X_BinTcp from above would
+// meet a tube other than `grasped`: a point of its axis (every 5 mm) within a radius of a pad's or
+// the housing's box, anywhere above the fingertips (z_Tcp points down). The planner keeps its
+// grasps clear of the cloud this way (grasp_filters.h); pads pushing a tube into the pile would
+// kick the kinematic gripper's neighbours apart rather than make a double pick.
+bool FingersMeetAnotherTube(const SimCell& cell, const std::vector<Tube>& tubes, std::size_t grasped,
+                            const Eigen::Isometry3d& X_BinTcp) {
+  const devices::sim::SimGripperParams& g = cell.params().gripper;
+  const double r = cell.cell().tube.radius;
+  const double pad_inner = 0.5 * kTrialOpening, pad_outer = pad_inner + g.finger_thickness;
+  const double housing_bottom = g.finger_tip_depth - g.finger_length - g.housing_gap;
+  const Eigen::Isometry3d X_TcpBin = X_BinTcp.inverse();
+  auto meets = [&](const Eigen::Vector3d& p_Bin) {
+    const Eigen::Vector3d p = X_TcpBin * p_Bin;
+    if (p.z() > g.finger_tip_depth + r) return false;  // below the fingertips
+    const bool pad = std::abs(p.x()) < 0.5 * g.finger_width + r && std::abs(p.y()) > pad_inner - r &&
+                     std::abs(p.y()) < pad_outer + r;
+    const bool housing = p.z() < housing_bottom + r && std::abs(p.x()) < 0.5 * g.housing_size.x() + r &&
+                         std::abs(p.y()) < 0.5 * g.housing_size.y() + r;
+    return pad || housing;
+  };
+  for (std::size_t t = 0; t < tubes.size(); ++t) {
+    if (t == grasped) continue;
+    for (const Cylinder& c : tubes[t].cylinders) {
+      const int steps = std::max(1, static_cast<int>(std::ceil(c.length() / 0.005)));
+      for (int k = 0; k <= steps; ++k) {
+        if (meets(c.start + (static_cast<double>(k) / steps) * (c.end - c.start))) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// The grasp at the middle of tubes[t]'s flattest cylinder (≥ 4 cm, inclined < 17°) nearest its
+// centre of mass `com` whose fingers meet no other tube.
+std::optional<Eigen::Isometry3d> MiddleGrasp(const SimCell& cell, const std::vector<Tube>& tubes,
+                                             std::size_t t, const Eigen::Vector3d& com) {
+  Eigen::Isometry3d best = Eigen::Isometry3d::Identity();
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Cylinder& c : tubes[t].cylinders) {
+    if (c.length() < 0.04 || std::abs(c.axis().z()) > 0.3) continue;
+    const Eigen::Vector3d middle = 0.5 * (c.start + c.end);
+    const double d = (middle - com).head<2>().norm();
+    if (d >= nearest) continue;
+    const std::optional<Eigen::Isometry3d> X = GraspFrame(middle, c.axis());
+    if (!X || FingersMeetAnotherTube(cell, tubes, t, *X)) continue;
+    nearest = d;
+    best = *X;
+  }
+  if (!std::isfinite(nearest)) return std::nullopt;
+  return best;
+}
+
+}  // namespace
+
+std::optional<TrialGrasp> ChooseTrialGrasp(const SimCell& cell, const std::vector<std::size_t>& tried) {
+  const std::vector<physics::TubeGeometry> truth = cell.TubesBin();
+  const std::vector<Eigen::Vector3d> coms = cell.TubeCentresOfMass();
+  std::vector<Tube> tubes;
+  for (const physics::TubeGeometry& g : truth) tubes.push_back(g.ToTube());
+  std::optional<TrialGrasp> best;
+  double best_height = -1.0;
+  for (std::size_t t = 0; t < tubes.size(); ++t) {
+    const std::size_t on_it = TubesLyingOn(tubes, t, CertaintyParams{}).size();
+    if (on_it == 0 || coms[t].z() <= best_height) continue;
+    if (std::find(tried.begin(), tried.end(), t) != tried.end()) continue;
+    const std::optional<Eigen::Isometry3d> X_BinTcp = MiddleGrasp(cell, tubes, t, coms[t]);
+    if (!X_BinTcp) continue;
+    best = TrialGrasp{t, on_it, *X_BinTcp};
+    best_height = coms[t].z();
+  }
+  return best;
+}
+
+ResolutionTrial RunResolutionTrial(SimCell& cell, const WrenchParams& wrench, const TrialParams& tp) {
+  ResolutionTrial trial;
+  trial.seed = cell.params().seed;
+  std::vector<std::size_t> tried;
+  trial.outside_at_start = cell.TubesOutsideBin();
+  try {
+    cell.robot().ServoOn(kLong);
+    cell.gripper().Activate(kLong);
+    while (trial.lifts < tp.max_lifts && !trial.multiple) {
+      const std::optional<TrialGrasp> grasp = ChooseTrialGrasp(cell, tried);
+      if (!grasp) break;
+      tried.push_back(grasp->tube);
+      ++trial.lifts;
+      trial.tube = grasp->tube;
+      trial.tubes_on_it = grasp->tubes_on_it;
+      LiftAndResolve(cell, *grasp, wrench, tp, trial);
+    }
+  } catch (const devices::DeviceFault& e) {
+    trial.fault = e.what();
+  } catch (const devices::DeviceTimeout& e) {
+    trial.fault = e.what();
+  }
+  RecordTruth(cell, trial);
+  return trial;
+}
+
+ResolutionTrial RunResolutionTrial(const SimCellParams& params, const WrenchParams& wrench,
+                                   const TrialParams& tp) {
+  SimCell cell(params);
+  return RunResolutionTrial(cell, wrench, tp);
+}
+
+}  // namespace tubepick::cli
+
+namespace tubepick::cli {
+namespace {
+
+struct TrialsOptions {
+  std::vector<std::string> materials = {"pvc", "rubber"};
+  std::vector<std::string> variants = {"torque_axis", "torque_axis_negative", "perpendicular"};
+  std::vector<double> angles_deg = {45.0};
+  std::string shapes;  // empty: the material's thesis set
+  std::uint32_t tubes = 10;
+  std::uint32_t bins = 40;
+  std::uint64_t seed = 1;
+  TrialParams trial;
+  std::uint32_t jobs = 2;
+  std::string json_path;
+};
+
+// Counts over the bins of one material, variant and angle.
+struct ArmSummary {
+  std::uint32_t bins = 0, lifts = 0, multiple = 0, freed = 0, second_motion = 0, outside = 0, faults = 0;
+};
+
+std::vector<ResolutionTrial> RunArm(const SimCellParams& base, const WrenchParams& wrench,
+                                    const TrialsOptions& o) {
+  std::vector<ResolutionTrial> trials(o.bins);
+  std::atomic<std::uint32_t> next{0};
+  std::vector<std::thread> workers;
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  for (std::uint32_t w = 0; w < std::max(1u, o.jobs); ++w) {
+    workers.emplace_back([&] {
+      for (std::uint32_t i = next++; i < o.bins; i = next++) {
+        try {
+          SimCellParams params = base;
+          params.seed = o.seed + i;
+          trials[i] = RunResolutionTrial(params, wrench, o.trial);
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(error_mutex);
+          error = std::current_exception();
+        }
+      }
+    });
+  }
+  for (std::thread& t : workers) t.join();
+  if (error) std::rethrow_exception(error);
+  return trials;
+}
+
+ArmSummary Summarise(const std::vector<ResolutionTrial>& trials) {
+  ArmSummary s;
+  s.bins = static_cast<std::uint32_t>(trials.size());
+  for (const ResolutionTrial& t : trials) {
+    s.lifts += t.lifts;
+    s.faults += !t.fault.empty();
+    s.outside += t.others_outside;
+    if (!t.multiple) continue;
+    ++s.multiple;
+    s.freed += t.freed;
+    s.second_motion += t.freed && t.motions_used > 1;
+  }
+  return s;
+}
+
+nlohmann::json TrialJson(const ResolutionTrial& t) {
+  return {{"seed", t.seed},
+          {"lifts", t.lifts},
+          {"tube", t.tube},
+          {"tubes_on_it", t.tubes_on_it},
+          {"multiple", t.multiple},
+          {"others_lifted", t.others_lifted},
+          {"motions_used", t.motions_used},
+          {"hold_shift", t.hold_shift},
+          {"freed", t.freed},
+          {"tube_held", t.tube_held},
+          {"outside_at_start", t.outside_at_start},
+          {"others_outside", t.others_outside},
+          {"fault", t.fault}};
+}
+
+std::string Percent(std::uint32_t part, std::uint32_t whole) {
+  return whole == 0 ? "–" : fmt::format("{:.0f} %", 100.0 * part / whole);
+}
+
+void RunTrials(const TrialsOptions& o) {
+  if (o.bins == 0) throw InvalidArgument("--bins: 0 (at least one bin)");
+  if (o.tubes < 2)
+    throw InvalidArgument(fmt::format("--tubes: {} (a double pick needs at least 2)", o.tubes));
+  nlohmann::json json = nlohmann::json::array();
+  fmt::print(
+      "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by the 2nd "
+      "motion | tubes outside the bin | gripper or robot faults |\n"
+      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const std::string& material_name : o.materials) {
+    const Material material = devices::sim::ParseMaterial(material_name, "--materials");
+    SimCellParams params = SimCellParams::Thesis(material, o.tubes, o.seed);
+    if (!o.shapes.empty()) WithShapes(o.shapes, &params);
+    const std::string shapes = o.shapes.empty() ? (material == Material::kRubber ? "B" : "A") : o.shapes;
+    for (const std::string& variant : o.variants) {
+      for (const double angle : o.angles_deg) {
+        WrenchParams wrench;
+        wrench.variant = ParseResolutionVariant(variant, "--variants");
+        wrench.rotation_angle = angle * kDegree;
+        wrench.Validate();
+        const std::vector<ResolutionTrial> trials = RunArm(params, wrench, o);
+        const ArmSummary s = Summarise(trials);
+        fmt::print("| {} | {} | {} | {:.0f}° | {} | {} | {} | {} ({}) | {} | {} | {} |\n", material_name,
+                   shapes, variant, angle, s.bins, s.lifts, s.multiple, s.freed, Percent(s.freed, s.multiple),
+                   s.second_motion, s.outside, s.faults);
+        nlohmann::json arm = {{"material", material_name}, {"shapes", shapes},
+                              {"variant", variant},        {"angle_deg", angle},
+                              {"tubes", o.tubes},          {"lift", o.trial.lift},
+                              {"dwell", o.trial.dwell},    {"trials", nlohmann::json::array()}};
+        for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
+        json.push_back(arm);
+      }
+    }
+  }
+  if (!o.json_path.empty()) WriteTextFile(o.json_path, json.dump(1) + "\n");
+}
+
+}  // namespace
+
+void AddResolutionTrialsCommand(CLI::App& app) {
+  auto o = std::make_shared<TrialsOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "resolution-trials",
+      "Double picks in generated bins of the simulated cell (a tube grasped under another): how often "
+      "each resolution rotation frees the extra tubes, and where they fall");
+  cmd->add_option("--materials", o->materials, "pvc, rubber")->delimiter(',')->capture_default_str();
+  cmd->add_option("--variants", o->variants, "torque_axis, torque_axis_negative, perpendicular, joint_safe")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--angles", o->angles_deg, "Rotation angles, degrees")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--shapes", o->shapes,
+                  "A, B, C or CY (default: the material's thesis set, pvc A, rubber B)");
+  cmd->add_option("--tubes", o->tubes, "Tubes per bin")->capture_default_str();
+  cmd->add_option("--bins", o->bins, "Bins (seeds seed, seed + 1, ...); the same bins for every variant")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the first bin")->capture_default_str();
+  cmd->add_option("--lift", o->trial.lift, "Lift before the reading, metres")->capture_default_str();
+  cmd->add_option("--hold-over-bin", o->trial.hold_over_bin,
+                  "Bring the payload over the bin's middle before the rotation, as the controller does")
+      ->capture_default_str();
+  cmd->add_option("--wall-margin", o->trial.wall_margin, "The hold pose's TCP inside the bin walls, metres")
+      ->capture_default_str();
+  cmd->add_option("--dwell", o->trial.dwell, "Wait at the end of each resolution motion, seconds")
+      ->capture_default_str();
+  cmd->add_option("--max-lifts", o->trial.max_lifts, "Lifts per bin until one holds several tubes")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--jobs", o->jobs, "Trials run in parallel")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd->add_option("--json", o->json_path, "Write every trial as JSON");
+  cmd->callback([o] { RunTrials(*o); });
+}
+
+}  // namespace tubepick::cli

@@ -1,0 +1,130 @@
+#include "clients/cli/cell/resolution_trials.h"
+
+#include <gtest/gtest.h>
+
+#include <deque>
+#include <vector>
+
+#include "clients/cell/local_wrench_analysis.h"
+#include "clients/cell/test/scripted_cell.h"
+#include "clients/cli/cell/sim_round.h"
+#include "devices/sim/test/sim_test_util.h"
+
+namespace tubepick::cli {
+namespace {
+
+using devices::sim::SimCell;
+using devices::sim::SimCellParams;
+using devices::sim::testing::PolylineTube;
+
+/// Tube A (0.4 m, four cylinders) along x on the floor; tube B a bridge across it at x = 0.05, its
+/// flat middle resting on A and its legs on the floor on both sides: lifting A carries B.
+std::vector<physics::TubeGeometry> BridgedTubes(double r) {
+  const double top = 3.0 * r + 0.001;
+  return {PolylineTube(1, {{-0.2, 0.0, r}, {-0.1, 0.0, r}, {0.0, 0.0, r}, {0.1, 0.0, r}, {0.2, 0.0, r}}, r),
+          PolylineTube(2, {{0.05, -0.22, r}, {0.05, -0.03, top}, {0.05, 0.03, top}, {0.05, 0.22, r}}, r)};
+}
+
+WrenchParams Resolution(ResolutionVariant variant) {
+  WrenchParams wrench;
+  wrench.variant = variant;
+  return wrench;
+}
+
+TEST(ResolutionTrials, ChoosesTheTubeAnotherLiesOnAtItsMiddle) {
+  const SimCellParams params;
+  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+  const std::optional<TrialGrasp> grasp = ChooseTrialGrasp(cell, {});
+  ASSERT_TRUE(grasp.has_value());
+  EXPECT_EQ(grasp->tube, 0u);
+  EXPECT_EQ(grasp->tubes_on_it, 1u);
+  // The middle of a cylinder next to A's centre of mass, on A's axis.
+  EXPECT_NEAR(std::abs(grasp->X_BinTcp.translation().x()), 0.05, 0.005);
+  EXPECT_NEAR(grasp->X_BinTcp.translation().y(), 0.0, 0.005);
+  // Nothing lies on B: once A is tried there is no trial grasp left.
+  EXPECT_FALSE(ChooseTrialGrasp(cell, {0}).has_value());
+}
+
+TEST(ResolutionTrials, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
+  const SimCellParams params;
+  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+  const ResolutionTrial trial =
+      RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), TrialParams{});
+  EXPECT_EQ(trial.fault, "");
+  EXPECT_EQ(trial.lifts, 1u);
+  EXPECT_TRUE(trial.multiple);
+  EXPECT_EQ(trial.others_lifted, 1u);  // B hung from A, clear of the floor
+  EXPECT_EQ(trial.motions_used, 1u);
+  EXPECT_TRUE(trial.freed);
+  EXPECT_TRUE(trial.tube_held);
+  EXPECT_EQ(trial.others_outside, 0u);
+  EXPECT_EQ(cell.TubesInBin(), 1u);  // B fell back; A is held above the bin
+}
+
+// PlanPick from a queue; AnalyzeWrench is the real analysis (the fast profile's, as the server's).
+class QueuePlanner final : public cell::PlannerClient {
+ public:
+  std::deque<v1::PlanPickResponse> answers;
+  std::vector<v1::AnalyzeWrenchRequest> wrench_requests;
+
+  v1::PlanPickResponse PlanPick(const v1::PlanPickRequest&, std::chrono::milliseconds) override {
+    if (answers.empty())
+      throw cell::PlannerError("PlanPick", grpc::StatusCode::UNAVAILABLE, "no answer left", 1);
+    v1::PlanPickResponse a = answers.front();
+    answers.pop_front();
+    return a;
+  }
+  v1::AnalyzeWrenchResponse AnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
+                                          std::chrono::milliseconds) override {
+    wrench_requests.push_back(request);
+    return cell::LocalAnalyzeWrench(request, "fast");
+  }
+};
+
+class MemorySink final : public cell::RecordSink {
+ public:
+  std::vector<nlohmann::json> records;
+  void Write(const nlohmann::json& record) override { records.push_back(record); }
+};
+
+TEST(ResolutionInTheCell, TheControllerCarriesADoublePickOverTheBinsMiddleAndFreesItThere) {
+  // The bridged pair off-centre: A from x = 0 to 0.3 m, grasped at its middle; B across it 0.1 m
+  // further out. Lifted, the payload's centre of mass is about 0.05 m beyond the TCP; the controller
+  // carries it over the bin's middle (TCP to x ≈ −0.05) before it turns the gripper.
+  SimCellParams params;
+  const double r = params.cell.tube.radius, top = 3.0 * r + 0.001;
+  const std::vector<physics::TubeGeometry> tubes = {
+      PolylineTube(1, {{0.0, 0.0, r}, {0.1, 0.0, r}, {0.2, 0.0, r}, {0.3, 0.0, r}}, r),
+      PolylineTube(2, {{0.25, -0.22, r}, {0.25, -0.03, top}, {0.25, 0.03, top}, {0.25, 0.22, r}}, r)};
+  SimCell sim(params, tubes);
+  QueuePlanner planner;
+  v1::PlanPickResponse plan = cell::testing::Plans({cell::testing::MakePlan(0, {0.15, 0.0, r})}, 2).response;
+  v1::PlanPickResponse empty;  // the round ends when the planner says so
+  empty.set_bin_empty(true);
+  planner.answers = {plan, empty};
+  MemorySink sink;
+  cell::CellControllerParams controller;
+  controller.disable_simulation = true;
+
+  const SimRoundResult result = RunSimRound(planner, sim, controller, 0, &sink);
+  EXPECT_EQ(result.run.picks, 1u) << result.run.message;
+  EXPECT_EQ(result.tubes_in_bin, 1u);  // B fell back into the bin
+  EXPECT_EQ(result.tubes_in_place_zone, 1u);
+  EXPECT_EQ(result.tubes_elsewhere, 0u);
+
+  nlohmann::json attempt;
+  for (const nlohmann::json& record : sink.records)
+    if (record.value("type", "") == "attempt") attempt = record;
+  ASSERT_FALSE(attempt.is_null());
+  EXPECT_EQ(attempt["analysis"]["outcome"], "multiple");
+  EXPECT_EQ(attempt["resolution"]["used"], 1);
+  EXPECT_EQ(attempt["resolution"]["succeeded"], true);
+  EXPECT_NEAR(attempt["resolution"]["payload_offset"][0].get<double>(), 0.05, 0.02);
+  EXPECT_NEAR(attempt["resolution"]["hold_shift"][0].get<double>(), -0.2, 0.02);
+  // The analysis after the rotation was asked at the hold pose.
+  ASSERT_EQ(planner.wrench_requests.size(), 2u);
+  EXPECT_LT(planner.wrench_requests[1].tcp_pose().position().x(), 0.0);
+}
+
+}  // namespace
+}  // namespace tubepick::cli
