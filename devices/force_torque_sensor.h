@@ -1,7 +1,10 @@
 #pragma once
 
+#include <cstdint>
+
 #include <Eigen/Core>
 
+#include "core/wrench/wrench.h"
 #include "devices/device_error.h"
 
 namespace tubepick::devices {
@@ -13,6 +16,9 @@ struct WrenchReading {
   /// Sensor-side sequence number or time stamp, when the device gives one.
   std::uint64_t sequence = 0;
 };
+
+/// The reading as the wrench analysis takes it (core/wrench/wrench.h: the same frame and signs).
+inline Wrench AsWrench(const WrenchReading& r) { return Wrench{r.force, r.torque}; }
 
 /// A 6-axis force/torque sensor (thesis §5.3.1.4).
 class ForceTorqueSensor {

@@ -222,8 +222,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   Eigen::Vector3d shift_Bin = Eigen::Vector3d::Zero();
   if (params_.resolution_hold_over_bin && analysis.resolution_motions_size() > 0) {
     const ResolutionHold hold =
-        PlanResolutionHold(Wrench{reference.force, reference.torque}, Wrench{lifted.force, lifted.torque},
-                           X_BinTcpLift, cell_.bin.inner_size, params_.resolution_wall_margin);
+        PlanResolutionHold(devices::AsWrench(reference), devices::AsWrench(lifted), X_BinTcpLift,
+                           cell_.bin.inner_size, params_.resolution_wall_margin);
     shift_Bin = hold.shift_Bin;
     resolution["payload_offset"] = {hold.p_TcpPayload_Bin.x(), hold.p_TcpPayload_Bin.y()};
   }

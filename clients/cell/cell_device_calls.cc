@@ -181,8 +181,8 @@ v1::AnalyzeWrenchRequest CellController::WrenchRequest(const devices::WrenchRead
                                                        const devices::WrenchReading& current,
                                                        const Eigen::Isometry3d& X_BinTcp) const {
   v1::AnalyzeWrenchRequest request;
-  *request.mutable_reference() = ToProto(Wrench{reference.force, reference.torque});
-  *request.mutable_current() = ToProto(Wrench{current.force, current.torque});
+  *request.mutable_reference() = ToProto(devices::AsWrench(reference));
+  *request.mutable_current() = ToProto(devices::AsWrench(current));
   request.set_tube_mass(cell_.tube.mass);
   *request.mutable_tcp_pose() = ToProto(X_BinTcp);
   request.set_variant(params_.resolution_variant);

@@ -292,8 +292,7 @@ TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   // The payload (1.2 N, its torque 0.03 / -0.01 N·m in the TCP axes) is first carried over the
   // bin's middle: the rotation turns about the TCP there.
   const ResolutionHold hold =
-      PlanResolutionHold(Wrench{Reading(0.1).force, Reading(0.1).torque},
-                         Wrench{Reading(1.3, 0.03, -0.01).force, Reading(1.3, 0.03, -0.01).torque},
+      PlanResolutionHold(devices::AsWrench(Reading(0.1)), devices::AsWrench(Reading(1.3, 0.03, -0.01)),
                          X_BinTcpLift, cell.bin.inner_size, params.resolution_wall_margin);
   ASSERT_GT(hold.shift_Bin.norm(), 0.05);
   const Eigen::Translation3d shift(hold.shift_Bin);

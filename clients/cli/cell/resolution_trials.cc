@@ -35,25 +35,29 @@ using devices::sim::Material;
 using devices::sim::SimCell;
 using devices::sim::SimCellParams;
 
+using devices::AsWrench;
+
 constexpr double kDegree = M_PI / 180.0;
 constexpr devices::Timeout kLong{std::chrono::seconds(120)};
-// Speeds of the controller's defaults (cell_controller_params.h): approach, lift, resolution.
-constexpr double kApproachSpeed = 0.05;
-constexpr double kLiftSpeed = 0.1;
-constexpr double kResolutionSpeed = 0.1;
-constexpr double kTransitSpeed = 0.25;
-// The fingers' opening on the way down, metres (the grasped tube is 2.5 cm thick).
+// The fingers' opening on the way down, metres (the grasped tube is 2.5 cm thick), and the
+// gripper's speeds (m/s) and force (N) of the measured trials (the simulated cell's own tests use
+// the same; the controller closes at its gripper_speed 0.1 and gripper_force 60).
 constexpr double kTrialOpening = 0.045;
+constexpr double kOpenSpeed = 0.1;
+constexpr double kCloseSpeed = 0.05;
+constexpr double kGripForce = 50.0;
 
-Wrench ToWrench(const devices::WrenchReading& r) { return Wrench{r.force, r.torque}; }
+Eigen::Isometry3d Above(Eigen::Isometry3d X_BinTcp, double height) {
+  X_BinTcp.translation().z() += height;
+  return X_BinTcp;
+}
 
-// Grasps: above, down, close (the fingers already open). False when the gripper closed on nothing.
-bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp) {
-  Eigen::Isometry3d above = X_BinTcpGrasp;
-  above.translation().z() += 0.10;
-  cell.robot().MoveTo(above, kTransitSpeed, kLong);
-  cell.robot().MoveTo(X_BinTcpGrasp, kApproachSpeed, kLong);
-  return cell.gripper().Close(0.05, 50.0, kLong).object == devices::GripperObject::kStoppedClosing;
+// Grasps: down from the pre-grasp pose, close (the fingers already open). False when the gripper
+// closed on nothing.
+bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::CellControllerParams& c) {
+  cell.robot().MoveTo(X_BinTcpGrasp, c.approach_speed, kLong);
+  return cell.gripper().Close(kCloseSpeed, kGripForce, kLong).object ==
+         devices::GripperObject::kStoppedClosing;
 }
 
 // The resolution as the controller runs it: with hold_over_bin, first to the hold pose
@@ -62,23 +66,24 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp) {
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
              ResolutionTrial& trial) {
+  const cell::CellControllerParams& c = tp.controller;
   const double tube_mass = cell.cell().tube.mass;
   const Eigen::Translation3d shift(
-      tp.hold_over_bin
-          ? PlanResolutionHold(reference, lifted, X_BinTcpLift, cell.cell().bin.inner_size, tp.wall_margin)
-                .shift_Bin
-          : Eigen::Vector3d::Zero());
+      c.resolution_hold_over_bin ? PlanResolutionHold(reference, lifted, X_BinTcpLift,
+                                                      cell.cell().bin.inner_size, c.resolution_wall_margin)
+                                       .shift_Bin
+                                 : Eigen::Vector3d::Zero());
   const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
   trial.hold_shift = shift.translation().norm();
-  cell.robot().MoveTo(X_BinTcpHold, kLiftSpeed, kLong);
+  cell.robot().MoveTo(X_BinTcpHold, c.lift_speed, kLong);
   for (const ResolutionMotion& motion : plan.motions) {
     ++trial.motions_used;
     for (const ResolutionWaypoint& w : motion.waypoints)
-      cell.robot().MoveTo(shift * w.X_BinTcpRotated, kResolutionSpeed, kLong);
+      cell.robot().MoveTo(shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (tp.dwell > 0.0) cell.Advance(tp.dwell);
-    cell.robot().MoveTo(X_BinTcpHold, kResolutionSpeed, kLong);
+    cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     const HeldCount again =
-        CountHeldTubes(reference, ToWrench(cell.ft_sensor().Read(kLong)), tube_mass, params);
+        CountHeldTubes(reference, AsWrench(cell.ft_sensor().Read(kLong)), tube_mass, params);
     if (again.outcome != HeldOutcome::kMultiple) {
       trial.freed = again.outcome == HeldOutcome::kSingle;
       return;
@@ -104,22 +109,24 @@ std::uint32_t OthersLifted(const SimCell& cell, std::size_t tube) {
 // for the next lift.
 void LiftAndResolve(SimCell& cell, const TrialGrasp& grasp, const WrenchParams& wrench, const TrialParams& tp,
                     ResolutionTrial& trial) {
-  cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
-  Eigen::Isometry3d above = grasp.X_BinTcp;
-  above.translation().z() += 0.10;
-  cell.robot().MoveTo(above, kTransitSpeed, kLong);
+  const cell::CellControllerParams& c = tp.controller;
+  const auto open = [&] { cell.gripper().MoveTo(kTrialOpening, kOpenSpeed, kGripForce, kLong); };
+  open();
+  const Eigen::Isometry3d above = Above(grasp.X_BinTcp, c.approach_height);
+  cell.robot().MoveTo(above, c.transit_speed, kLong);
   cell.ft_sensor().Bias(kLong);
-  const Wrench reference = ToWrench(cell.ft_sensor().Read(kLong));
-  if (!Grasp(cell, grasp.X_BinTcp)) {
-    cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
-    cell.robot().MoveTo(above, kApproachSpeed, kLong);
+  const Wrench reference = AsWrench(cell.ft_sensor().Read(kLong));
+  if (!Grasp(cell, grasp.X_BinTcp, c)) {
+    open();
+    cell.robot().MoveTo(above, c.approach_speed, kLong);
     return;
   }
-  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, tp.lift)}, kLiftSpeed, kLong);
+  cell.robot().MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, tp.lift)}, c.lift_speed,
+                           kLong);
   const Eigen::Isometry3d X_BinTcpLift = cell.X_BinTcp();
   const WrenchParams at_lift = WrenchParamsAtPose(wrench, X_BinTcpLift);
   const double mass = cell.cell().tube.mass;
-  const Wrench lifted = ToWrench(cell.ft_sensor().Read(kLong));
+  const Wrench lifted = AsWrench(cell.ft_sensor().Read(kLong));
   trial.multiple = CountHeldTubes(reference, lifted, mass, at_lift).outcome == HeldOutcome::kMultiple;
   if (trial.multiple) {
     trial.others_lifted = OthersLifted(cell, grasp.tube);
@@ -127,14 +134,12 @@ void LiftAndResolve(SimCell& cell, const TrialGrasp& grasp, const WrenchParams& 
             PlanResolutionRotation(reference, lifted, X_BinTcpLift, at_lift))
       Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift, tp, trial);
     if (trial.freed) return;  // held: the freed tubes fell, counted at the end
-    cell.robot().MoveTo(X_BinTcpLift, kLiftSpeed, kLong);
+    cell.robot().MoveTo(X_BinTcpLift, c.lift_speed, kLong);
   }
   // Put back, as the controller does with one tube here or several it could not free.
-  Eigen::Isometry3d release = grasp.X_BinTcp;
-  release.translation().z() += 0.03;
-  cell.robot().MoveTo(release, kLiftSpeed, kLong);
-  cell.gripper().MoveTo(kTrialOpening, 0.1, 50.0, kLong);
-  cell.robot().MoveTo(above, kApproachSpeed, kLong);
+  cell.robot().MoveTo(Above(grasp.X_BinTcp, c.release_height), c.lift_speed, kLong);
+  open();
+  cell.robot().MoveTo(above, c.approach_speed, kLong);
 }
 
 // Ground truth at the end: 2 s of rest, then whether the tube is held and how many others lie
@@ -395,10 +400,11 @@ void AddResolutionTrialsCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the first bin")->capture_default_str();
   cmd->add_option("--lift", o->trial.lift, "Lift before the reading, metres")->capture_default_str();
-  cmd->add_option("--hold-over-bin", o->trial.hold_over_bin,
+  cmd->add_option("--hold-over-bin", o->trial.controller.resolution_hold_over_bin,
                   "Bring the payload over the bin's middle before the rotation, as the controller does")
       ->capture_default_str();
-  cmd->add_option("--wall-margin", o->trial.wall_margin, "The hold pose's TCP inside the bin walls, metres")
+  cmd->add_option("--wall-margin", o->trial.controller.resolution_wall_margin,
+                  "The hold pose's TCP inside the bin walls, metres")
       ->capture_default_str();
   cmd->add_option("--dwell", o->trial.dwell, "Wait at the end of each resolution motion, seconds")
       ->capture_default_str();

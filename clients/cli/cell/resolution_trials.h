@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "clients/cell/cell_controller_params.h"
+#include "core/planning/trajectory_synthesis.h"
 #include "core/wrench/wrench_params.h"
 #include "devices/sim/sim_cell.h"
 
@@ -60,15 +62,15 @@ struct ResolutionTrial {
 /// How a trial moves.
 struct TrialParams {
   /// Lift before the reading, metres (the planner's upward_distance).
-  double lift = 0.40;
+  double lift = TrajectoryParams{}.upward_distance;
   /// Lifts per bin until one holds several tubes.
   std::uint32_t max_lifts = 6;
   /// Wait at the end of each resolution motion before the return to the hold pose, seconds.
   double dwell = 0.0;
-  /// As the controller (CellControllerParams::resolution_hold_over_bin): the payload is brought over
-  /// the bin's middle (PlanResolutionHold) before the rotation, the TCP wall_margin inside the walls.
-  bool hold_over_bin = true;
-  double wall_margin = 0.15;
+  /// The controller's speeds, approach and release heights and resolution hold
+  /// (resolution_hold_over_bin: the payload brought over the bin's middle, PlanResolutionHold,
+  /// before the rotation, the TCP resolution_wall_margin inside the walls).
+  cell::CellControllerParams controller;
 };
 
 /// Runs one trial in a generated bin (`params`): up to max_lifts lifts, each of the tube
