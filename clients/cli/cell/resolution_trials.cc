@@ -26,6 +26,7 @@
 #include "core/wrench/resolution_hold.h"
 #include "core/wrench/resolution_rotation.h"
 #include "devices/device_error.h"
+#include "physics/random_tubes.h"
 #include "wire/wrench_analysis.h"
 
 namespace tubepick::cli {
@@ -262,26 +263,13 @@ ResolutionTrial RunResolutionTrial(const SimCellParams& params, const WrenchPara
 namespace tubepick::cli {
 namespace {
 
-struct TrialsOptions {
-  std::vector<std::string> materials = {"pvc", "rubber"};
-  std::vector<std::string> variants = {"torque_axis", "torque_axis_negative", "perpendicular"};
-  std::vector<double> angles_deg = {45.0};
-  std::string shapes;  // empty: the material's thesis set
-  std::uint32_t tubes = 10;
-  std::uint32_t bins = 40;
-  std::uint64_t seed = 1;
-  TrialParams trial;
-  std::uint32_t jobs = 2;
-  std::string json_path;
-};
-
 // Counts over the bins of one material, variant and angle.
 struct ArmSummary {
   std::uint32_t bins = 0, lifts = 0, multiple = 0, freed = 0, second_motion = 0, outside = 0, faults = 0;
 };
 
 std::vector<ResolutionTrial> RunArm(const SimCellParams& base, const WrenchParams& wrench,
-                                    const TrialsOptions& o) {
+                                    const ResolutionTrialsOptions& o) {
   std::vector<ResolutionTrial> trials(o.bins);
   std::atomic<std::uint32_t> next{0};
   std::vector<std::thread> workers;
@@ -341,10 +329,8 @@ std::string Percent(std::uint32_t part, std::uint32_t whole) {
   return whole == 0 ? "–" : fmt::format("{:.0f} %", 100.0 * part / whole);
 }
 
-void RunTrials(const TrialsOptions& o) {
-  if (o.bins == 0) throw InvalidArgument("--bins: 0 (at least one bin)");
-  if (o.tubes < 2)
-    throw InvalidArgument(fmt::format("--tubes: {} (a double pick needs at least 2)", o.tubes));
+void RunTrials(const ResolutionTrialsOptions& o) {
+  ValidateResolutionTrials(o);
   nlohmann::json json = nlohmann::json::array();
   fmt::print(
       "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by the 2nd "
@@ -380,8 +366,37 @@ void RunTrials(const TrialsOptions& o) {
 
 }  // namespace
 
+void ValidateResolutionTrials(const ResolutionTrialsOptions& o) {
+  if (o.bins == 0) throw InvalidArgument("--bins: 0 (at least one bin)");
+  if (o.tubes < 2)
+    throw InvalidArgument(fmt::format("--tubes: {} (a double pick needs at least 2)", o.tubes));
+  for (const std::string& m : o.materials) devices::sim::ParseMaterial(m, "--materials");
+  for (const std::string& v : o.variants) ParseResolutionVariant(v, "--variants");
+  for (const double angle : o.angles_deg) {
+    // A few degrees shake nothing; 0.8 is 46° in radians, the likely mistake.
+    if (!(angle >= 5.0 && angle <= 90.0))
+      throw InvalidArgument(fmt::format(
+          "--angles: {}° is out of range [5, 90] (degrees; a value below 5 looks like radians)", angle));
+  }
+  if (!o.shapes.empty()) {
+    try {
+      physics::RandomTubeParams::Preset(o.shapes);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(std::string("--shapes: ") + e.what());
+    }
+  }
+  if (!(o.trial.lift > 0.0))
+    throw InvalidArgument(
+        fmt::format("--lift: {} m (the lift before the reading must be positive)", o.trial.lift));
+  if (!(o.trial.dwell >= 0.0))
+    throw InvalidArgument(fmt::format("--dwell: {} s (a wait, at least 0)", o.trial.dwell));
+  if (!(o.trial.controller.resolution_wall_margin >= 0.0))
+    throw InvalidArgument(fmt::format("--wall-margin: {} m (inside the bin walls, at least 0)",
+                                      o.trial.controller.resolution_wall_margin));
+}
+
 void AddResolutionTrialsCommand(CLI::App& app) {
-  auto o = std::make_shared<TrialsOptions>();
+  auto o = std::make_shared<ResolutionTrialsOptions>();
   CLI::App* cmd = app.add_subcommand(
       "resolution-trials",
       "Double picks in generated bins of the simulated cell (a tube grasped under another): how often "

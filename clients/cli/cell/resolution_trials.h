@@ -88,6 +88,23 @@ ResolutionTrial RunResolutionTrial(const devices::sim::SimCellParams& params, co
 ResolutionTrial RunResolutionTrial(devices::sim::SimCell& cell, const WrenchParams& wrench,
                                    const TrialParams& trial_params);
 
+/// The options of `tubepick resolution-trials`.
+struct ResolutionTrialsOptions {
+  std::vector<std::string> materials = {"pvc", "rubber"};
+  std::vector<std::string> variants = {"torque_axis", "torque_axis_negative", "perpendicular"};
+  std::vector<double> angles_deg = {45.0};
+  std::string shapes;  // empty: the material's thesis set
+  std::uint32_t tubes = 10;
+  std::uint32_t bins = 40;
+  std::uint64_t seed = 1;
+  TrialParams trial;
+  std::uint32_t jobs = 2;
+  std::string json_path;
+};
+
+/// Checks every option before a trial runs. @throws InvalidArgument naming the flag and its value.
+void ValidateResolutionTrials(const ResolutionTrialsOptions& o);
+
 /// `tubepick resolution-trials`: how often each resolution rotation frees the extra tube of a
 /// double pick in the simulated cell, per material, variant and angle.
 void AddResolutionTrialsCommand(CLI::App& app);

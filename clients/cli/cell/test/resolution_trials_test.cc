@@ -1,5 +1,6 @@
 #include "clients/cli/cell/resolution_trials.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <deque>
@@ -8,6 +9,7 @@
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/test/scripted_cell.h"
 #include "clients/cli/cell/sim_round.h"
+#include "core/common/errors.h"
 #include "devices/sim/test/sim_test_util.h"
 
 namespace tubepick::cli {
@@ -16,6 +18,7 @@ namespace {
 using devices::sim::SimCell;
 using devices::sim::SimCellParams;
 using devices::sim::testing::PolylineTube;
+using ::testing::HasSubstr;
 
 /// Tube A (0.4 m, four cylinders) along x on the floor; tube B a bridge across it at x = 0.05, its
 /// flat middle resting on A and its legs on the floor on both sides: lifting A carries B.
@@ -59,6 +62,38 @@ TEST(ResolutionTrials, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
   EXPECT_TRUE(trial.tube_held);
   EXPECT_EQ(trial.others_outside, 0u);
   EXPECT_EQ(cell.TubesInBin(), 1u);  // B fell back; A is held above the bin
+}
+
+std::string ErrorOf(const ResolutionTrialsOptions& o) {
+  try {
+    ValidateResolutionTrials(o);
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ResolutionTrials, EveryBadOptionIsRefusedByNameBeforeATrialRuns) {
+  EXPECT_EQ(ErrorOf(ResolutionTrialsOptions{}), "");
+  auto with = [](auto change) {
+    ResolutionTrialsOptions o;
+    change(o);
+    return ErrorOf(o);
+  };
+  EXPECT_THAT(with([](auto& o) {
+                o.materials = {"pvc", "wood"};
+              }),
+              HasSubstr("--materials: unknown material 'wood'"));
+  EXPECT_THAT(with([](auto& o) { o.variants = {"sideways"}; }), HasSubstr("--variants"));
+  EXPECT_THAT(with([](auto& o) { o.angles_deg = {45.0, 0.8}; }), HasSubstr("--angles: 0.8"));
+  EXPECT_THAT(with([](auto& o) { o.angles_deg = {120.0}; }), HasSubstr("--angles: 120°"));
+  EXPECT_THAT(with([](auto& o) { o.shapes = "Q"; }), HasSubstr("--shapes: unknown random tube preset 'Q'"));
+  EXPECT_THAT(with([](auto& o) { o.bins = 0; }), HasSubstr("--bins: 0"));
+  EXPECT_THAT(with([](auto& o) { o.tubes = 1; }), HasSubstr("--tubes: 1"));
+  EXPECT_THAT(with([](auto& o) { o.trial.lift = 0.0; }), HasSubstr("--lift: 0 m"));
+  EXPECT_THAT(with([](auto& o) { o.trial.dwell = -1.0; }), HasSubstr("--dwell: -1 s"));
+  EXPECT_THAT(with([](auto& o) { o.trial.controller.resolution_wall_margin = -0.1; }),
+              HasSubstr("--wall-margin: -0.1 m"));
 }
 
 // PlanPick from a queue; AnalyzeWrench is the real analysis (the fast profile's, as the server's).
