@@ -132,6 +132,20 @@ void DescribeFields(Visit& v, JoiningParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, EndRoomParams& p) {
+  v("max_unfitted", p.max_unfitted,
+    "unfitted surface past a free end lengthens its reach by up to this, m; 0 = off");
+  v("attach_distance", p.attach_distance, "unfitted points this close to the end start that surface, m");
+  v("link_distance", p.link_distance, "unfitted points in touching cells of this size are one surface, m");
+  v("corridor", p.corridor, "that surface is followed within the radius plus this of the extended axis, m");
+  v("free_space_check", p.free_space_check, "no reach past where the scanner saw through the branch's place");
+  v("free_space_step", p.free_space_step, "free space: probe spacing along the extended axis, m");
+  v("free_space_tolerance", p.free_space_tolerance,
+    "free space: a surface up to this behind the axis hides it, m");
+  v("free_space_window", p.free_space_window, "free space: range image pixels around each probe");
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, JunctionParams& p) {
   v("max_gap", p.max_gap, "Y-pieces: each free end's axis is extended by its radius plus this, m");
   v("max_axis_offset", p.max_axis_offset, "Y-pieces: between two extended axes where they meet, m");
@@ -152,6 +166,7 @@ void DescribeFields(Visit& v, JunctionParams& p) {
     "topology auto: junctions a scene needs to count as branched");
   v("auto_min_per_tube", p.auto_min_per_tube, "topology auto: and this many per tube they leave");
   v("auto_min_y_pieces", p.auto_min_y_pieces, "topology auto: or this many Y-pieces");
+  v.Section("end_room", p.end_room);
 }
 
 template <typename Visit>

@@ -160,16 +160,23 @@ struct MeetingNode {
   Eigen::Vector3d Centre() const { return sum / points; }
 };
 
+// The reach of a chain's free end (ReachOf), nominal without rooms.
+double RoomReach(const EndRooms& rooms, std::uint32_t chain, bool at_end, double nominal) {
+  return chain < rooms.size() ? ReachOf(rooms[chain][at_end ? 1 : 0], nominal) : nominal;
+}
+
 // Pairs of free ends of different chains whose axes, each extended by at most its radius plus
 // max_gap, pass within max_axis_offset of each other at an angle of at least min_angle, or that
 // face each other along one line within that reach (a run broken at a T-piece's node; alone,
 // such a pair is the linear joining's business, so only a third end makes it a node). Ends
 // pointing the same way side by side never meet. Cheapest first.
-std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const JunctionParams& params) {
+std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const JunctionParams& params,
+                                        const EndRooms& rooms) {
   const double cos_min = std::cos(params.min_angle);
   struct End {
     std::pair<std::uint32_t, bool> id;
     FreeEnd end;
+    double radius;
     double reach;
   };
   std::vector<End> ends;
@@ -177,13 +184,16 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
     if (chains[c].cylinders.empty() || chains[c].branched()) continue;
     for (const bool at_end : {false, true}) {
       const double radius = (at_end ? chains[c].cylinders.back() : chains[c].cylinders.front()).radius;
-      ends.push_back({{c, at_end}, EndOf(chains[c], at_end), radius + params.max_gap});
+      ends.push_back({{c, at_end},
+                      EndOf(chains[c], at_end),
+                      radius,
+                      RoomReach(rooms, c, at_end, radius + params.max_gap)});
     }
   }
   std::vector<EndMeeting> out;
   // As the linear joining measures a pair (α + β, no angle below the mean radius: touching ends).
   auto linkable = [&](const End& x, const End& y) {
-    const double mean_radius = 0.5 * (x.reach + y.reach) - params.max_gap;
+    const double mean_radius = 0.5 * (x.radius + y.radius);
     const JoinDistance d =
         EndpointDistance(x.end.p, x.end.out, y.end.p, y.end.out, mean_radius, JoiningParams{});
     return d.euclidean <= params.link_max_distance && d.angular <= params.link_max_angle;
@@ -193,7 +203,8 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
       const End& x = ends[i];
       const End& y = ends[k];
       if (x.id.first == y.id.first) continue;
-      if ((x.end.p - y.end.p).norm() > x.reach + y.reach + params.max_axis_offset) continue;
+      const double reach_x = x.reach, reach_y = y.reach;
+      if ((x.end.p - y.end.p).norm() > reach_x + reach_y + params.max_axis_offset) continue;
       const double alignment = x.end.out.dot(y.end.out);
       if (alignment > cos_min) continue;  // side by side, pointing the same way
       if (alignment < -cos_min) {
@@ -202,17 +213,17 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
         const Eigen::Vector3d gap = y.end.p - x.end.p;
         const double along = gap.dot(x.end.out);
         const double offset = (gap - along * x.end.out).norm();
-        if (along <= 0.0 || along > x.reach + y.reach || offset > params.max_axis_offset) continue;
+        if (along <= 0.0 || along > reach_x + reach_y || offset > params.max_axis_offset) continue;
         out.push_back({x.id, y.id, 0.5 * (x.end.p + y.end.p), along + offset, linkable(x, y)});
         continue;
       }
-      const SegmentClosestPoints cp = ClosestPointsOfSegments(x.end.p, x.end.p + x.reach * x.end.out, y.end.p,
-                                                              y.end.p + y.reach * y.end.out);
+      const SegmentClosestPoints cp = ClosestPointsOfSegments(x.end.p, x.end.p + reach_x * x.end.out, y.end.p,
+                                                              y.end.p + reach_y * y.end.out);
       if (cp.distance > params.max_axis_offset) continue;
-      const Eigen::Vector3d px = x.end.p + cp.s * x.reach * x.end.out;
-      const Eigen::Vector3d py = y.end.p + cp.t * y.reach * y.end.out;
+      const Eigen::Vector3d px = x.end.p + cp.s * reach_x * x.end.out;
+      const Eigen::Vector3d py = y.end.p + cp.t * reach_y * y.end.out;
       out.push_back(
-          {x.id, y.id, 0.5 * (px + py), cp.s * x.reach + cp.t * y.reach + cp.distance, linkable(x, y)});
+          {x.id, y.id, 0.5 * (px + py), cp.s * reach_x + cp.t * reach_y + cp.distance, linkable(x, y)});
     }
   }
   std::stable_sort(out.begin(), out.end(), [](const EndMeeting& u, const EndMeeting& v) {
@@ -524,10 +535,13 @@ void JunctionParams::Validate() const {
   RequireInRange(link_max_angle, 0.0, kPi, "modeling.junctions.link_max_angle");
   RequireInRange(chain_max_angle, 0.0, kPi, "modeling.junctions.chain_max_angle");
   RequireNonNegative(auto_min_per_tube, "modeling.junctions.auto_min_per_tube");
+  end_room.Validate("modeling.junctions.end_room");
 }
 
+double ReachOf(const EndRoom& room, double nominal) { return std::min(nominal + room.unfitted, room.free); }
+
 std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                                    JunctionShape shape) {
+                                    JunctionShape shape, const EndRooms& rooms) {
   params.Validate();
   const double cos_min = std::cos(params.min_angle);
   std::vector<Junction> out;
@@ -550,7 +564,7 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
           const Eigen::Vector3d axis = piece.b - piece.a;
           if (!(axis.norm() > 0.0)) continue;
           if (std::abs(end.out.dot(axis.normalized())) > cos_min) continue;
-          const double reach = piece.radius + params.side_max_gap;
+          const double reach = RoomReach(rooms, b, at_end, piece.radius + params.side_max_gap);
           const SegmentClosestPoints cp =
               ClosestPointsOfSegments(end.p, end.p + reach * end.out, piece.a, piece.b);
           if (cp.distance > params.side_max_axis_offset) continue;
@@ -578,11 +592,11 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
 }
 
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                              JunctionShape shape, const StopToken* stop) {
+                              JunctionShape shape, const StopToken* stop, const EndRooms& rooms) {
   params.Validate();
   ThrowIfStopped(stop, "joining");
-  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params), params),
-                                   FindJunctions(chains, params, shape), params, shape, stop);
+  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+                                   FindJunctions(chains, params, shape, rooms), params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),

@@ -49,6 +49,20 @@ std::vector<std::int32_t> TubeOfPoint(const std::vector<Tube>& tubes, const std:
   return tube_of_point;
 }
 
+// The points no fitted cylinder took as an inlier.
+Points UnfittedPoints(const Points& points,
+                      const std::vector<const std::vector<std::uint32_t>*>& inliers_of) {
+  std::vector<char> fitted(points.size(), 0);
+  for (const auto* inliers : inliers_of) {
+    for (const std::uint32_t i : *inliers) fitted[i] = 1;
+  }
+  Points out;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!fitted[i]) out.push_back(points[i]);
+  }
+  return out;
+}
+
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // SplitMix64: derives independent, reproducible seeds for each stochastic step.
@@ -232,7 +246,9 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
     chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
     const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
-    JunctionJoining joined = JoinJunctions(chains, params.junctions, input.junction_shape, stop);
+    const EndRooms rooms =
+        MeasureEndRooms(UnfittedPoints(cloud.points, inliers_of), chains, params.junctions.end_room, seen);
+    JunctionJoining joined = JoinJunctions(chains, params.junctions, input.junction_shape, stop, rooms);
     const bool branched =
         input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
     spdlog::debug("junctions: {} ({} Y-pieces) joining {} of {} chains into {} tubes; topology {}: {}",

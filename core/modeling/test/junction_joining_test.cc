@@ -8,6 +8,7 @@
 
 #include "core/common/errors.h"
 #include "core/common/tube_graph.h"
+#include "core/modeling/end_room.h"
 
 namespace tubepick {
 namespace {
@@ -120,6 +121,46 @@ TEST(JunctionJoining, LimitsKeepTreesAndSizes) {
   EXPECT_THAT(
       [&] { JoinJunctions(chains, params); },
       ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_branches_per_node: 2")));
+}
+
+TEST(JunctionJoining, TheRoomPastAnEndSetsItsReach) {
+  // A run along x; a branch along y whose cylinder ends 8 cm from the run's axis (region growing
+  // left its last centimetres unfitted): beyond the T-piece reach (radius + side_max_gap).
+  const Eigen::Vector3d foot(0.16, 0, kR);
+  const std::vector<Tube> chains = {Chain({Cyl({0, 0, kR}, {0.30, 0, kR}, 0)}),
+                                    Chain({Cyl(foot + 0.18 * Dir(90), foot + 0.08 * Dir(90), 1)})};
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}).tubes.size(), 2u);
+  // 4 cm of unfitted surface past the branch's end make the junction.
+  EndRooms rooms(2);
+  rooms[1][1].unfitted = 0.04;
+  const JunctionJoining joined = JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, rooms);
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  EXPECT_TRUE(joined.tubes[0].branched());
+  // Where the scanner saw past the branch's axis 5 cm out, it does not reach the run.
+  rooms[1][1].free = 0.05;
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, rooms).tubes.size(), 2u);
+  // Free space 1 cm out refuses even a branch ending 3 cm from the run, nominally within reach
+  // (the shortened axis must still come within side_max_axis_offset of the run's).
+  const std::vector<Tube> near = {chains[0], Chain({Cyl(foot + 0.13 * Dir(90), foot + 0.03 * Dir(90), 1)})};
+  EXPECT_EQ(JoinJunctions(near, JunctionParams{}).tubes.size(), 1u);
+  EndRooms seen_through(2);
+  seen_through[1][1].free = 0.01;
+  EXPECT_EQ(JoinJunctions(near, JunctionParams{}, JunctionShape::kAny, nullptr, seen_through).tubes.size(),
+            2u);
+  EXPECT_DOUBLE_EQ(ReachOf(EndRoom{0.04, 0.2}, 0.05), 0.09);
+  EXPECT_DOUBLE_EQ(ReachOf(EndRoom{0.04, 0.07}, 0.05), 0.07);
+}
+
+TEST(JunctionJoining, TwoArmsOfAYWhoseThirdIsHiddenAreLinkedAcrossAWideKink) {
+  // Two arms 50° apart leave a node 2.5 cm from their ends (a kink of 130°); the third arm is
+  // hidden. Their axes meet, so they are one tube; the thesis-like 90° limit would leave two.
+  const Eigen::Vector3d node(0, 0, kR);
+  const std::vector<Tube> chains = {Chain({Cyl(node + 0.30 * Dir(180), node + 0.025 * Dir(180), 0)}),
+                                    Chain({Cyl(node + 0.025 * Dir(130), node + 0.15 * Dir(130), 1)})};
+  ASSERT_EQ(JoinJunctions(chains, JunctionParams{}).tubes.size(), 1u);
+  JunctionParams params;
+  params.link_max_angle = kPi / 2.0;
+  EXPECT_EQ(JoinJunctions(chains, params).tubes.size(), 2u);
 }
 
 // A run along x with a branch at `branch_degrees` from it, ending 3 cm from the run's axis.
