@@ -155,6 +155,8 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
   v("ft_read_retries", p.ft_read_retries, "tries again after a reading timed out");
   v("ft_spike_force", p.ft_spike_force, "N off the median: a spike, dropped");
   v("ft_spike_torque", p.ft_spike_torque, "N*m off the median: a spike, dropped");
+  v("ft_unsettled_retries", p.ft_unsettled_retries,
+    "measures again after one whose readings mostly disagreed");
   v.Heading("scanner");
   v("scan_retries", p.scan_retries, "scans again after a timeout or an empty scan");
   DescribePlannerFields(v, p);

@@ -92,6 +92,11 @@ struct CellControllerParams {
   /// is a spike and dropped; half of the readings or more dropped is a fault.
   double ft_spike_force = 2.0;
   double ft_spike_torque = 0.2;
+  /// Further measurements (settle samples, then ft_samples readings) after one whose readings
+  /// mostly disagreed, before that is a fault: a payload still swinging settles, a loose cable or
+  /// a saturated gauge does not (a held pvc tree swinging over the place zone once safe-stopped a
+  /// simulated round, docs/ACCURACY.md).
+  std::uint32_t ft_unsettled_retries = 2;
 
   // --- scanner ---
   /// Further scans after a scan that timed out or returned no point, before it is a fault.

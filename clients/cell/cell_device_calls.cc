@@ -5,6 +5,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
@@ -147,34 +149,56 @@ devices::WrenchReading CellController::ReadOneWrench() {
   }
 }
 
-devices::WrenchReading CellController::ReadWrench() {
-  for (std::uint32_t i = 0; i < params_.ft_settle_samples; ++i) ReadOneWrench();
-  std::vector<devices::WrenchReading> readings;
-  for (std::uint32_t i = 0; i < params_.ft_samples; ++i) readings.push_back(ReadOneWrench());
+namespace {
+
+// The mean of the readings within spike_force / spike_torque of their median; nullopt when half of
+// them or more lie farther (*dropped: how many lay farther).
+std::optional<devices::WrenchReading> MeanWithoutSpikes(const std::vector<devices::WrenchReading>& readings,
+                                                        double spike_force, double spike_torque,
+                                                        std::size_t* dropped) {
   const Eigen::Vector3d force_median = MedianOf(readings, &devices::WrenchReading::force);
   const Eigen::Vector3d torque_median = MedianOf(readings, &devices::WrenchReading::torque);
   devices::WrenchReading mean;
   std::uint32_t kept = 0;
   for (const devices::WrenchReading& r : readings) {
-    if ((r.force - force_median).norm() > params_.ft_spike_force ||
-        (r.torque - torque_median).norm() > params_.ft_spike_torque)
+    if ((r.force - force_median).norm() > spike_force || (r.torque - torque_median).norm() > spike_torque)
       continue;
     mean.force += r.force;
     mean.torque += r.torque;
     mean.sequence = r.sequence;
     ++kept;
   }
-  if (2 * kept <= readings.size())
-    throw CellFault("ft_sensor", FaultKind::kDeviceFault, ToString(state_),
-                    fmt::format("{} of {} readings are more than {} N / {} N*m off their median (a loose "
-                                "cable, a hit tool, a saturated gauge?)",
-                                readings.size() - kept, readings.size(), params_.ft_spike_force,
-                                params_.ft_spike_torque));
-  if (kept < readings.size())
-    spdlog::warn("cell: {} F/T spike(s) dropped of {} readings", readings.size() - kept, readings.size());
+  *dropped = readings.size() - kept;
+  if (2 * kept <= readings.size()) return std::nullopt;
   mean.force /= kept;
   mean.torque /= kept;
   return mean;
+}
+
+}  // namespace
+
+devices::WrenchReading CellController::ReadWrench() {
+  for (std::uint32_t measurement = 0;; ++measurement) {
+    for (std::uint32_t i = 0; i < params_.ft_settle_samples; ++i) ReadOneWrench();
+    std::vector<devices::WrenchReading> readings;
+    for (std::uint32_t i = 0; i < params_.ft_samples; ++i) readings.push_back(ReadOneWrench());
+    std::size_t dropped = 0;
+    if (const std::optional<devices::WrenchReading> mean =
+            MeanWithoutSpikes(readings, params_.ft_spike_force, params_.ft_spike_torque, &dropped)) {
+      if (dropped > 0) spdlog::warn("cell: {} F/T spike(s) dropped of {} readings", dropped, readings.size());
+      return *mean;
+    }
+    const std::string disagreement =
+        fmt::format("{} of {} readings are more than {} N / {} N*m off their median", dropped,
+                    readings.size(), params_.ft_spike_force, params_.ft_spike_torque);
+    if (measurement >= params_.ft_unsettled_retries) {
+      throw CellFault("ft_sensor", FaultKind::kDeviceFault, ToString(state_),
+                      fmt::format("{}, in each of {} measurements (a loose cable, a hit tool, a saturated "
+                                  "gauge?)",
+                                  disagreement, measurement + 1));
+    }
+    spdlog::warn("cell: {} (the payload still swinging?); settling and measuring again", disagreement);
+  }
 }
 
 v1::AnalyzeWrenchRequest CellController::WrenchRequest(const devices::WrenchReading& reference,

@@ -679,15 +679,43 @@ TEST_F(CellControllerTest, ForceTorqueSpikesAreDroppedFromTheMean) {
   EXPECT_NEAR(planner.wrench_requests[0].current().force().z(), 0.64, 1e-12);  // 25.6 N dropped
 }
 
-TEST_F(CellControllerTest, MostlySpikesAreAForceTorqueFault) {
+TEST_F(CellControllerTest, MostlySpikesInEveryMeasurementAreAForceTorqueFault) {
   params.ft_samples = 3;
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
-  ft.readings = {Reading(0.10), Reading(9.0), Reading(-9.0)};
+  // Three measurements (ft_unsettled_retries = 2), each of them mostly spikes: no settling helps.
+  ft.readings = {Reading(0.10), Reading(9.0),  Reading(-9.0), Reading(0.10), Reading(9.0),
+                 Reading(-9.0), Reading(0.10), Reading(9.0),  Reading(-9.0)};
   const CellRunResult result = Run();
   ASSERT_TRUE(result.fault);
   EXPECT_EQ(result.fault->device(), "ft_sensor");
   EXPECT_EQ(result.fault->state(), "reference");
-  EXPECT_NE(result.message.find("2 of 3 readings are more than 2 N"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("2 of 3 readings are more than 2 N / 0.2 N*m off their median, in each of 3 "
+                                "measurements"),
+            std::string::npos)
+      << result.message;
+  EXPECT_EQ(ft.reads, 9);
+  params.ft_unsettled_retries = 0;  // the old behaviour: the first such measurement is a fault
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  ft.readings = {Reading(0.10), Reading(9.0), Reading(-9.0)};
+  const CellRunResult at_once = Run();
+  ASSERT_TRUE(at_once.fault);
+  EXPECT_NE(at_once.message.find("in each of 1 measurements"), std::string::npos) << at_once.message;
+}
+
+TEST_F(CellControllerTest, AMeasurementOfASwingingPayloadIsTakenAgainAfterSettling) {
+  params.ft_samples = 3;
+  params.ft_settle_samples = 1;
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  // Reference: settle + 3 steady readings. After the lift the payload swings through the first
+  // measurement (2 of 3 far off), then hangs still: the second measurement is the one used.
+  ft.readings = {Reading(0.10), Reading(0.10), Reading(0.10), Reading(0.10), Reading(3.0),  Reading(0.64),
+                 Reading(-2.5), Reading(4.0),  Reading(0.9),  Reading(0.64), Reading(0.64), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  const CellRunResult result = Run();
+  EXPECT_FALSE(result.fault) << result.message;
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  ASSERT_EQ(planner.wrench_requests.size(), 1u);
+  EXPECT_NEAR(planner.wrench_requests[0].current().force().z(), 0.64, 1e-12);
 }
 
 TEST_F(CellControllerTest, PlannerUnavailableBeforeTheGraspStopsWhereTheArmIs) {
