@@ -94,8 +94,8 @@ struct CellControllerParams {
   double ft_spike_torque = 0.2;
   /// Further measurements (settle samples, then ft_samples readings) after one whose readings
   /// mostly disagreed, before that is a fault: a payload still swinging settles, a loose cable or
-  /// a saturated gauge does not (a held pvc tree swinging over the place zone once safe-stopped a
-  /// simulated round, docs/ACCURACY.md).
+  /// a saturated gauge does not (in the simulated set-C rounds one such measurement was steady at
+  /// the next try; one that stayed off through three still safe-stopped its round, docs/ACCURACY.md).
   std::uint32_t ft_unsettled_retries = 2;
 
   // --- scanner ---
