@@ -30,6 +30,30 @@ Eigen::Vector3d MedianOf(const std::vector<devices::WrenchReading>& readings,
   return median;
 }
 
+// The mean of the readings within spike_force / spike_torque of their median; nullopt when half of
+// them or more lie farther (*dropped: how many lay farther).
+std::optional<devices::WrenchReading> MeanWithoutSpikes(const std::vector<devices::WrenchReading>& readings,
+                                                        double spike_force, double spike_torque,
+                                                        std::size_t* dropped) {
+  const Eigen::Vector3d force_median = MedianOf(readings, &devices::WrenchReading::force);
+  const Eigen::Vector3d torque_median = MedianOf(readings, &devices::WrenchReading::torque);
+  devices::WrenchReading mean;
+  std::uint32_t kept = 0;
+  for (const devices::WrenchReading& r : readings) {
+    if ((r.force - force_median).norm() > spike_force || (r.torque - torque_median).norm() > spike_torque)
+      continue;
+    mean.force += r.force;
+    mean.torque += r.torque;
+    mean.sequence = r.sequence;
+    ++kept;
+  }
+  *dropped = readings.size() - kept;
+  if (2 * kept <= readings.size()) return std::nullopt;
+  mean.force /= kept;
+  mean.torque /= kept;
+  return mean;
+}
+
 }  // namespace
 
 using detail::CallDevice;
@@ -148,34 +172,6 @@ devices::WrenchReading CellController::ReadOneWrench() {
     }
   }
 }
-
-namespace {
-
-// The mean of the readings within spike_force / spike_torque of their median; nullopt when half of
-// them or more lie farther (*dropped: how many lay farther).
-std::optional<devices::WrenchReading> MeanWithoutSpikes(const std::vector<devices::WrenchReading>& readings,
-                                                        double spike_force, double spike_torque,
-                                                        std::size_t* dropped) {
-  const Eigen::Vector3d force_median = MedianOf(readings, &devices::WrenchReading::force);
-  const Eigen::Vector3d torque_median = MedianOf(readings, &devices::WrenchReading::torque);
-  devices::WrenchReading mean;
-  std::uint32_t kept = 0;
-  for (const devices::WrenchReading& r : readings) {
-    if ((r.force - force_median).norm() > spike_force || (r.torque - torque_median).norm() > spike_torque)
-      continue;
-    mean.force += r.force;
-    mean.torque += r.torque;
-    mean.sequence = r.sequence;
-    ++kept;
-  }
-  *dropped = readings.size() - kept;
-  if (2 * kept <= readings.size()) return std::nullopt;
-  mean.force /= kept;
-  mean.torque /= kept;
-  return mean;
-}
-
-}  // namespace
 
 devices::WrenchReading CellController::ReadWrench() {
   for (std::uint32_t measurement = 0;; ++measurement) {

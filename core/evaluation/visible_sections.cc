@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "core/common/errors.h"
+#include "core/common/grid_cell_key.h"
 
 namespace tubepick {
 namespace {
@@ -26,12 +27,6 @@ struct DisjointSets {
     if (a != b) parent[std::max(a, b)] = std::min(a, b);
   }
 };
-
-std::uint64_t CellKey(std::int64_t x, std::int64_t y, std::int64_t z) {
-  constexpr std::int64_t kOffset = 1 << 20;  // ±1 M cells of ≥ 1 mm: ±1 km
-  return (static_cast<std::uint64_t>(x + kOffset) << 42) | (static_cast<std::uint64_t>(y + kOffset) << 21) |
-         static_cast<std::uint64_t>(z + kOffset);
-}
 
 }  // namespace
 
@@ -57,7 +52,7 @@ std::vector<std::uint32_t> CountVisibleSections(const Points& points, const std:
   for (std::uint32_t i = 0; i < points.size(); ++i) {
     if (truth[i] < 0 || truth[i] >= static_cast<std::int32_t>(tube_count) || !points[i].allFinite()) continue;
     const Eigen::Vector3i c = cell_of(points[i]);
-    grid[CellKey(c.x(), c.y(), c.z())].push_back(i);
+    grid[GridCellKey(c.x(), c.y(), c.z())].push_back(i);
   }
   DisjointSets sets(points.size());
   for (const auto& [key, members] : grid) {
@@ -66,7 +61,7 @@ std::vector<std::uint32_t> CountVisibleSections(const Points& points, const std:
       for (int dx = -1; dx <= 1; ++dx) {
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dz = -1; dz <= 1; ++dz) {
-            const auto it = grid.find(CellKey(c.x() + dx, c.y() + dy, c.z() + dz));
+            const auto it = grid.find(GridCellKey(c.x() + dx, c.y() + dy, c.z() + dz));
             if (it == grid.end()) continue;
             for (std::uint32_t j : it->second) {
               if (j <= i || truth[j] != truth[i]) continue;

@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "core/common/errors.h"
+#include "core/common/grid_cell_key.h"
 #include "core/common/require.h"
 
 namespace tubepick {
@@ -22,17 +23,6 @@ namespace {
 
 // How far free space is probed: beyond the longest reach junction joining gives an end.
 constexpr double kFreeSpaceHorizon = 0.2;
-
-struct EndRay {
-  Eigen::Vector3d p;
-  Eigen::Vector3d out;
-  double radius;
-};
-
-EndRay RayOf(const Tube& chain, bool at_end) {
-  const Cylinder& c = at_end ? chain.cylinders.back() : chain.cylinders.front();
-  return at_end ? EndRay{c.end, c.axis(), c.radius} : EndRay{c.start, -c.axis(), c.radius};
-}
 
 // The unfitted points on a grid of link_distance cells, each occupied cell one node at the mean
 // of its points; cells touching (26-neighbourhood) are one surface.
@@ -58,7 +48,7 @@ class UnfittedWalk {
     stamp_.assign(centre_.size(), 0);
   }
 
-  double Measure(const EndRay& ray) {
+  double Measure(const FreeEnd& ray) {
     ++walk_;
     const double lateral_limit = ray.radius + params_.corridor;
     double furthest = 0.0;
@@ -102,11 +92,7 @@ class UnfittedWalk {
   Eigen::Vector3i CellOf(const Eigen::Vector3d& p) const {
     return (p / cell_).array().floor().cast<int>().matrix();
   }
-  static std::uint64_t Key(const Eigen::Vector3i& c) {
-    // 21 bits per axis: ±10 km at a centimetre.
-    auto bits = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v) & 0x1FFFFFu); };
-    return (bits(c.x()) << 42) | (bits(c.y()) << 21) | bits(c.z());
-  }
+  static std::uint64_t Key(const Eigen::Vector3i& c) { return GridCellKey(c.x(), c.y(), c.z()); }
 
   const EndRoomParams& params_;
   double cell_;
@@ -116,11 +102,11 @@ class UnfittedWalk {
   std::uint32_t walk_ = 0;
 };
 
-double FreeSpaceAhead(const RangeImage& seen, const EndRay& ray, const EndRoomParams& params) {
+double FreeSpaceAhead(const RangeImage& seen, const FreeEnd& ray, const EndRoomParams& params) {
   double t = params.free_space_step;
   for (; t <= kFreeSpaceHorizon; t += params.free_space_step) {
     const Eigen::Vector3d q = ray.p + t * ray.out;
-    if (!seen.IsGapCovered(q, q, static_cast<int>(params.free_space_window), -params.free_space_tolerance)) {
+    if (!seen.IsPointCovered(q, static_cast<int>(params.free_space_window), -params.free_space_tolerance)) {
       return t;
     }
   }
@@ -128,6 +114,11 @@ double FreeSpaceAhead(const RangeImage& seen, const EndRay& ray, const EndRoomPa
 }
 
 }  // namespace
+
+FreeEnd FreeEndOf(const Tube& chain, bool at_end) {
+  const Cylinder& c = at_end ? chain.cylinders.back() : chain.cylinders.front();
+  return at_end ? FreeEnd{c.end, c.axis(), c.radius} : FreeEnd{c.start, -c.axis(), c.radius};
+}
 
 void EndRoomParams::Validate(const char* prefix) const {
   const std::string p = prefix;
@@ -155,7 +146,7 @@ EndRooms MeasureEndRooms(const Points& unfitted, const std::vector<Tube>& chains
   for (std::size_t c = 0; c < chains.size(); ++c) {
     if (chains[c].cylinders.empty() || chains[c].branched()) continue;
     for (const bool at_end : {false, true}) {
-      const EndRay ray = RayOf(chains[c], at_end);
+      const FreeEnd ray = FreeEndOf(chains[c], at_end);
       EndRoom& room = rooms[c][at_end ? 1 : 0];
       if (walk) room.unfitted = walk->Measure(ray);
       if (check_free) room.free = FreeSpaceAhead(*seen, ray, params);

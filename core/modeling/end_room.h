@@ -41,6 +41,16 @@ struct EndRoomParams {
   void Validate(const char* prefix) const;
 };
 
+/// A linear chain's free end: its centre, the outward direction of its axis and its radius.
+struct FreeEnd {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+/// `at_end`: the last cylinder's end, else the first cylinder's start. @pre non-empty chain.
+FreeEnd FreeEndOf(const Tube& chain, bool at_end);
+
 /// The room past one free end, metres along its outward axis.
 struct EndRoom {
   /// Unfitted surface connected to the end goes on this far.

@@ -45,17 +45,6 @@ constexpr double kPi = 3.14159265358979323846;
 // moves to its nearer end.
 constexpr double kMinPiece = 0.002;
 
-// A chain's free end: its position and the outward direction of its axis.
-struct FreeEnd {
-  Eigen::Vector3d p;
-  Eigen::Vector3d out;
-};
-
-FreeEnd EndOf(const Tube& chain, bool at_end) {
-  const Cylinder& c = at_end ? chain.cylinders.back() : chain.cylinders.front();
-  return at_end ? FreeEnd{c.end, c.axis()} : FreeEnd{c.start, -c.axis()};
-}
-
 // Arc length along a chain's axis pieces at a position (piece index + fraction).
 double ArcAt(const std::vector<AxisPiece>& pieces, double position) {
   const auto k = static_cast<std::size_t>(position);
@@ -176,24 +165,20 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
   struct End {
     std::pair<std::uint32_t, bool> id;
     FreeEnd end;
-    double radius;
     double reach;
   };
   std::vector<End> ends;
   for (std::uint32_t c = 0; c < chains.size(); ++c) {
     if (chains[c].cylinders.empty() || chains[c].branched()) continue;
     for (const bool at_end : {false, true}) {
-      const double radius = (at_end ? chains[c].cylinders.back() : chains[c].cylinders.front()).radius;
-      ends.push_back({{c, at_end},
-                      EndOf(chains[c], at_end),
-                      radius,
-                      RoomReach(rooms, c, at_end, radius + params.max_gap)});
+      const FreeEnd end = FreeEndOf(chains[c], at_end);
+      ends.push_back({{c, at_end}, end, RoomReach(rooms, c, at_end, end.radius + params.max_gap)});
     }
   }
   std::vector<EndMeeting> out;
   // As the linear joining measures a pair (α + β, no angle below the mean radius: touching ends).
   auto linkable = [&](const End& x, const End& y) {
-    const double mean_radius = 0.5 * (x.radius + y.radius);
+    const double mean_radius = 0.5 * (x.end.radius + y.end.radius);
     const JoinDistance d =
         EndpointDistance(x.end.p, x.end.out, y.end.p, y.end.out, mean_radius, JoiningParams{});
     return d.euclidean <= params.link_max_distance && d.angular <= params.link_max_angle;
@@ -203,8 +188,7 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
       const End& x = ends[i];
       const End& y = ends[k];
       if (x.id.first == y.id.first) continue;
-      const double reach_x = x.reach, reach_y = y.reach;
-      if ((x.end.p - y.end.p).norm() > reach_x + reach_y + params.max_axis_offset) continue;
+      if ((x.end.p - y.end.p).norm() > x.reach + y.reach + params.max_axis_offset) continue;
       const double alignment = x.end.out.dot(y.end.out);
       if (alignment > cos_min) continue;  // side by side, pointing the same way
       if (alignment < -cos_min) {
@@ -213,17 +197,17 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
         const Eigen::Vector3d gap = y.end.p - x.end.p;
         const double along = gap.dot(x.end.out);
         const double offset = (gap - along * x.end.out).norm();
-        if (along <= 0.0 || along > reach_x + reach_y || offset > params.max_axis_offset) continue;
+        if (along <= 0.0 || along > x.reach + y.reach || offset > params.max_axis_offset) continue;
         out.push_back({x.id, y.id, 0.5 * (x.end.p + y.end.p), along + offset, linkable(x, y)});
         continue;
       }
-      const SegmentClosestPoints cp = ClosestPointsOfSegments(x.end.p, x.end.p + reach_x * x.end.out, y.end.p,
-                                                              y.end.p + reach_y * y.end.out);
+      const SegmentClosestPoints cp = ClosestPointsOfSegments(x.end.p, x.end.p + x.reach * x.end.out, y.end.p,
+                                                              y.end.p + y.reach * y.end.out);
       if (cp.distance > params.max_axis_offset) continue;
-      const Eigen::Vector3d px = x.end.p + cp.s * reach_x * x.end.out;
-      const Eigen::Vector3d py = y.end.p + cp.t * reach_y * y.end.out;
+      const Eigen::Vector3d px = x.end.p + cp.s * x.reach * x.end.out;
+      const Eigen::Vector3d py = y.end.p + cp.t * y.reach * y.end.out;
       out.push_back(
-          {x.id, y.id, 0.5 * (px + py), cp.s * reach_x + cp.t * reach_y + cp.distance, linkable(x, y)});
+          {x.id, y.id, 0.5 * (px + py), cp.s * x.reach + cp.t * y.reach + cp.distance, linkable(x, y)});
     }
   }
   std::stable_sort(out.begin(), out.end(), [](const EndMeeting& u, const EndMeeting& v) {
@@ -300,7 +284,7 @@ std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<T
       for (std::size_t c = b + 1; c < k; ++c) {
         const std::vector<std::pair<std::uint32_t, bool>> ends = {n.ends[a], n.ends[b], n.ends[c]};
         std::vector<Eigen::Vector3d> arms;
-        for (const auto& [chain, at_end] : ends) arms.push_back(-EndOf(chains[chain], at_end).out);
+        for (const auto& [chain, at_end] : ends) arms.push_back(-FreeEndOf(chains[chain], at_end).out);
         const double deviation = ShapeDeviation(arms, shape);
         if (deviation > best_deviation) continue;
         best_deviation = deviation;
@@ -328,7 +312,7 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
     double links = 0.0;
     for (const auto& [chain, at_end] : n.ends) {
       roots.push_back(forest.Find(chain));
-      links += (EndOf(chains[chain], at_end).p - n.Centre()).norm();
+      links += (FreeEndOf(chains[chain], at_end).p - n.Centre()).norm();
     }
     std::sort(roots.begin(), roots.end());
     if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return;  // a cycle
@@ -349,7 +333,7 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
   for (const Junction& j : candidates) {
     ThrowIfStopped(stop, "joining");
     if (end_used[j.branch][j.at_end ? 1 : 0] || forest.Find(j.branch) == forest.Find(j.host)) continue;
-    const double link = (j.p_Bin - EndOf(chains[j.branch], j.at_end).p).norm();
+    const double link = (j.p_Bin - FreeEndOf(chains[j.branch], j.at_end).p).norm();
     if (params.max_tube_length > 0.0 &&
         forest.Length(j.branch) + forest.Length(j.host) + link > params.max_tube_length) {
       continue;
@@ -419,7 +403,7 @@ class TreeBuilder {
       if (j.branch == chain && j.at_end == at_end)
         return node_id_.at({j.host, accepted_.node_of_junction[i]});
     }
-    tube_.nodes.push_back(TubeNode{EndOf(chains_[chain], at_end).p});
+    tube_.nodes.push_back(TubeNode{FreeEndOf(chains_[chain], at_end).p});
     return static_cast<std::uint32_t>(tube_.nodes.size() - 1);
   }
 
@@ -554,7 +538,7 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
   for (std::uint32_t b = 0; b < chains.size(); ++b) {
     if (chains[b].cylinders.empty() || chains[b].branched()) continue;
     for (const bool at_end : {false, true}) {
-      const FreeEnd end = EndOf(chains[b], at_end);
+      const FreeEnd end = FreeEndOf(chains[b], at_end);
       std::optional<Junction> best_overall;
       for (std::uint32_t h = 0; h < chains.size(); ++h) {
         if (h == b || chains[h].branched()) continue;

@@ -81,11 +81,21 @@ bool RangeImage::IsGapCovered(const Eigen::Vector3d& a_Bin, const Eigen::Vector3
   // Midpoint of the two projections, in (continuous) pixel coordinates.
   const double mu = 0.5 * ((a_S.x() / a_S.z() - u0_) + (b_S.x() / b_S.z() - u0_)) / pixel_angle_;
   const double mv = 0.5 * ((a_S.y() / a_S.z() - v0_) + (b_S.y() / b_S.z() - v0_)) / pixel_angle_;
+  return AnyNearerAround(mu, mv, std::max(a_S.z(), b_S.z()) - margin, window);
+}
+
+bool RangeImage::IsPointCovered(const Eigen::Vector3d& p_Bin, int window, double margin) const {
+  if (width_ == 0 || height_ == 0) return false;
+  const Eigen::Vector3d p_S = X_SensorBin_ * p_Bin;
+  if (!p_S.allFinite() || p_S.z() <= kMinDepth) return false;
+  return AnyNearerAround((p_S.x() / p_S.z() - u0_) / pixel_angle_, (p_S.y() / p_S.z() - v0_) / pixel_angle_,
+                         p_S.z() - margin, window);
+}
+
+bool RangeImage::AnyNearerAround(double mu, double mv, double threshold, int window) const {
   const double cu = std::floor(mu);
   const double cv = std::floor(mv);
   if (cu < 0.0 || cv < 0.0 || cu >= width_ || cv >= height_) return false;  // out of the image
-
-  const double threshold = std::max(a_S.z(), b_S.z()) - margin;
   const int iu = static_cast<int>(cu);
   const int iv = static_cast<int>(cv);
   const int r = std::max(0, window);

@@ -27,12 +27,21 @@ class RangeImage {
   bool IsGapCovered(const Eigen::Vector3d& a_Bin, const Eigen::Vector3d& b_Bin, int window,
                     double margin = 0.0) const;
 
+  /// The same test at one point: some pixel within `window` pixels of p_Bin's projection holds a
+  /// depth smaller than p_Bin's minus `margin` (a negative margin also counts a surface that far
+  /// behind p_Bin). False outside the image or behind the sensor.
+  bool IsPointCovered(const Eigen::Vector3d& p_Bin, int window, double margin = 0.0) const;
+
   int width() const { return width_; }
   int height() const { return height_; }
   /// Depth at pixel (u, v); +inf when empty.
   float depth(int u, int v) const { return depth_[static_cast<std::size_t>(v) * width_ + u]; }
 
  private:
+  /// Whether a pixel within `window` of continuous pixel coordinates (mu, mv) holds a depth below
+  /// `threshold`; false outside the image.
+  bool AnyNearerAround(double mu, double mv, double threshold, int window) const;
+
   Eigen::Isometry3d X_SensorBin_;
   double pixel_angle_;
   double u0_ = 0.0, v0_ = 0.0;  // angular coordinate of pixel (0, 0)
