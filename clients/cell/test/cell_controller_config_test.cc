@@ -250,6 +250,9 @@ TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
             std::string::npos);
   EXPECT_NE(ParseError("ft_spike_torque: .nan\n").find("ft_spike_torque"), std::string::npos);
   EXPECT_NE(ParseError("scan_retries: -1\n").find("scan_retries"), std::string::npos);
+  EXPECT_NE(ParseError("ft_unsettled_retries: -1\n").find("ft_unsettled_retries: -1 is out of range"),
+            std::string::npos)
+      << ParseError("ft_unsettled_retries: -1\n");
   EXPECT_NE(ParseError("ft_read_retries: two\n").find("ft_read_retries"), std::string::npos);
 }
 
