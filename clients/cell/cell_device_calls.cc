@@ -12,6 +12,7 @@
 #include "clients/cell/cell_controller_internal.h"
 #include "clients/cell/local_wrench_analysis.h"
 #include "core/common/errors.h"
+#include "core/wrench/wrench_params.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::cell {
@@ -52,6 +53,18 @@ std::optional<devices::WrenchReading> MeanWithoutSpikes(const std::vector<device
   mean.force /= kept;
   mean.torque /= kept;
   return mean;
+}
+
+// Why readings keep disagreeing: a load far beyond a tube's weight (kPressingTubes of them) is
+// the tool or the held tube pressing on something that gives way; a small one, the sensor.
+std::string LikelyDisagreementCause(double load, double tube_weight) {
+  constexpr double kPressingTubes = 10.0;
+  if (load > kPressingTubes * tube_weight) {
+    return fmt::format("their median load is {:.1f} N, {:.0f} times a tube's weight: the tool or the held "
+                       "tube is pressing on something, a pile on the place zone or an obstacle?",
+                       load, load / tube_weight);
+  }
+  return fmt::format("their median load is {:.1f} N: a loose cable, a hit tool, a saturated gauge?", load);
 }
 
 }  // namespace
@@ -188,10 +201,10 @@ devices::WrenchReading CellController::ReadWrench() {
         fmt::format("{} of {} readings are more than {} N / {} N*m off their median", dropped,
                     readings.size(), params_.ft_spike_force, params_.ft_spike_torque);
     if (measurement >= params_.ft_unsettled_retries) {
+      const double load = MedianOf(readings, &devices::WrenchReading::force).norm();
       throw CellFault("ft_sensor", FaultKind::kDeviceFault, ToString(state_),
-                      fmt::format("{}, in each of {} measurements (a loose cable, a hit tool, a saturated "
-                                  "gauge?)",
-                                  disagreement, measurement + 1));
+                      fmt::format("{}, in each of {} measurements ({})", disagreement, measurement + 1,
+                                  LikelyDisagreementCause(load, cell_.tube.mass * WrenchParams{}.gravity)));
     }
     spdlog::warn("cell: {} (the payload still swinging?); settling and measuring again", disagreement);
   }

@@ -140,6 +140,14 @@ void SimCellState::TickRobotAlarm(double dt) {
       "robot: alarm 4100 (injected: overrun) at ({:.3f}, {:.3f}, {:.3f}) m; servo off", p.x(), p.y(), p.z()));
 }
 
+void SimCellState::ClearPlaceZone() {
+  if (!params.place_zone_conveyor) return;
+  const std::uint32_t carried = world->CarryOff([&](const Eigen::Vector3d& p) {
+    return BesideBin(p, params.cell.bin) && OverPlaceZone(p, params.cell, params.place_zone_size);
+  });
+  if (carried > 0) spdlog::debug("sim cell: the conveyor carried off {} placed tube(s)", carried);
+}
+
 void SimCellState::Advance(double seconds) {
   const int steps = static_cast<int>(std::ceil(seconds / params.physics.time_step - 1e-9));
   for (int i = 0; i < steps; ++i) world->ControlStep();
@@ -199,6 +207,13 @@ std::uint32_t SimCell::TubesInPlaceZone() const {
   return CountTubes(impl_->state, false, [&](const Eigen::Vector3d& p) {
     return BesideBin(p, cell().bin) && OverPlaceZone(p, cell(), params().place_zone_size);
   });
+}
+
+std::uint32_t SimCell::TubesCarriedOff() const {
+  const SimWorld& world = *impl_->state.world;
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < world.tube_count(); ++i) count += world.carried_off(i) ? 1 : 0;
+  return count;
 }
 
 std::uint32_t SimCell::TubesElsewhere() const {

@@ -179,6 +179,11 @@ struct SimCellParams {
   /// default (0.8 × 0.9 m around the thesis cell's place frame at y = 0.8 m) reaches the bin's
   /// outer wall, so a tube that slips in transit falls into the bin or onto the zone.
   Eigen::Vector2d place_zone_size{0.8, 0.9};
+  /// The place zone is a conveyor: before every scan (between picks) it carries off each tube at
+  /// rest on it (the tube leaves the world and still counts as placed), as a real cell's conveyor
+  /// or an operator clears its place zone. false: a table, where placed tubes pile up until later
+  /// ones push them off or a held tube lands on the pile.
+  bool place_zone_conveyor = true;
   /// The virtual scanner (its wall_thickness is the rendered walls').
   physics::ScannerParams scanner;
   SimGripperParams gripper;
@@ -264,6 +269,8 @@ class SimCell {
   std::uint32_t TubesOutsideBin() const;
   /// Tubes outside the bin whose centre of mass lies over the place zone (SimCellParams::place_zone_size).
   std::uint32_t TubesInPlaceZone() const;
+  /// Of them, the tubes the conveyor has carried off (SimCellParams::place_zone_conveyor).
+  std::uint32_t TubesCarriedOff() const;
   /// Tubes neither in the bin, nor in the place zone, nor held: on the floor, on a wall, anywhere a
   /// tube must never be released.
   std::uint32_t TubesElsewhere() const;

@@ -53,6 +53,9 @@ struct SimCellState {
   void TickSlip(double dt);
   /// Advances the armed robot alarm by `dt`; when due: servo off and DeviceFault.
   void TickRobotAlarm(double dt);
+  /// The conveyor (SimCellParams::place_zone_conveyor): carries off every tube at rest on the place
+  /// zone; nothing without it.
+  void ClearPlaceZone();
   /// Steps whole control steps with the gripper still for at least `seconds`.
   void Advance(double seconds);
   /// Raw F/T reading averaged over the F/T window (the world advances by it): payload wrench plus

@@ -23,6 +23,7 @@ devices::Capture SimScanner::Scan(Timeout timeout) {
     throw DeviceTimeout(
         fmt::format("scanner: a scan takes {:.2f} s, the timeout is {:.3f} s", duration, Seconds(timeout)));
   }
+  state_.ClearPlaceZone();
   state_.Advance(duration);
   if (state_.empty_scan_next) {
     state_.empty_scan_next = false;
@@ -32,7 +33,7 @@ devices::Capture SimScanner::Scan(Timeout timeout) {
                             .X_BinSensor = state_.params.cell.sensor.X_BinSensor};
   }
   const physics::ScanResult scan =
-      physics::ScanScene(state_.world->TubesBin(), state_.params.cell, state_.params.scanner,
+      physics::ScanScene(state_.world->TubesInWorldBin(), state_.params.cell, state_.params.scanner,
                          physics::DeriveSeed(state_.params.seed, kScanStream + state_.scans++));
   devices::Capture capture;
   capture.unit = state_.params.cell.sensor.unit;

@@ -90,6 +90,7 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
   for (std::size_t i = 0; i < tubes_Bin.size(); ++i) {
     tubes_.push_back(AddSimTube(*world_, tubes_Bin[i], i, options));
   }
+  carried_off_.assign(tubes_.size(), false);
 
   // The gripper: kinematic bodies (moved pose by pose; they push tubes with infinite mass).
   const SimGripperParams& g = params_.gripper;
@@ -128,10 +129,22 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
 
 SimWorld::~SimWorld() {
   ReleaseAll();
-  for (SimTube& tube : tubes_) {
-    for (auto& joint : tube.joints) world_->world->removeConstraint(joint.get());
+  for (std::size_t i = 0; i < tubes_.size(); ++i) {
+    if (carried_off_[i]) continue;
+    for (auto& joint : tubes_[i].joints) world_->world->removeConstraint(joint.get());
   }
 }
+
+namespace {
+
+bool AtRest(const SimTube& tube) {
+  return std::all_of(tube.links.begin(), tube.links.end(), [](const SimLink& link) {
+    return link.body->getLinearVelocity().length() < kRestLinear &&
+           link.body->getAngularVelocity().length() < kRestAngular;
+  });
+}
+
+}  // namespace
 
 bool SimWorld::Settle(double max_seconds) {
   double rest = 0.0;
@@ -139,13 +152,8 @@ bool SimWorld::Settle(double max_seconds) {
   while (time_ - start < max_seconds - 1e-12 && rest < kRestTime) {
     ControlStep();
     bool all_at_rest = true;
-    for (const SimTube& tube : tubes_) {
-      for (const SimLink& link : tube.links) {
-        if (link.body->getLinearVelocity().length() >= kRestLinear ||
-            link.body->getAngularVelocity().length() >= kRestAngular) {
-          all_at_rest = false;
-        }
-      }
+    for (std::size_t i = 0; i < tubes_.size(); ++i) {
+      if (!carried_off_[i] && !AtRest(tubes_[i])) all_at_rest = false;
     }
     rest = all_at_rest ? rest + params_.physics.time_step : 0.0;
   }
@@ -357,6 +365,30 @@ std::vector<physics::TubeGeometry> SimWorld::TubesBin() const {
   std::vector<physics::TubeGeometry> out;
   for (const SimTube& tube : tubes_) out.push_back(CurrentGeometry(tube));
   return out;
+}
+
+std::vector<physics::TubeGeometry> SimWorld::TubesInWorldBin() const {
+  std::vector<physics::TubeGeometry> out;
+  for (std::size_t i = 0; i < tubes_.size(); ++i) {
+    if (!carried_off_[i]) out.push_back(CurrentGeometry(tubes_[i]));
+  }
+  return out;
+}
+
+std::uint32_t SimWorld::CarryOff(const std::function<bool(const Eigen::Vector3d&)>& where) {
+  const std::vector<std::size_t> held = HeldTubes();
+  std::uint32_t count = 0;
+  for (std::size_t i = 0; i < tubes_.size(); ++i) {
+    if (carried_off_[i] || std::binary_search(held.begin(), held.end(), i) || !AtRest(tubes_[i]) ||
+        !where(TubeCentreOfMass(i))) {
+      continue;
+    }
+    for (auto& joint : tubes_[i].joints) world_->world->removeConstraint(joint.get());
+    for (const SimLink& link : tubes_[i].links) world_->world->removeRigidBody(link.body);
+    carried_off_[i] = true;
+    ++count;
+  }
+  return count;
 }
 
 }  // namespace tubepick::devices::sim

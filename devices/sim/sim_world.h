@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -88,7 +90,16 @@ class SimWorld {
   bool holding() const { return !grasps_.empty(); }
 
   std::size_t tube_count() const { return tubes_.size(); }
+  /// Every tube where it is (a carried-off tube where it was carried off), by index.
   std::vector<physics::TubeGeometry> TubesBin() const;
+  /// The tubes still in the world (what a scanner can see), in index order.
+  std::vector<physics::TubeGeometry> TubesInWorldBin() const;
+
+  /// Takes out of the world every tube that is not held, has been carried off before, lies at
+  /// rest and whose centre of mass satisfies `where` (a conveyor carrying placed parts away): its
+  /// bodies and joints leave the Bullet world, its pose and index stay. Returns how many.
+  std::uint32_t CarryOff(const std::function<bool(const Eigen::Vector3d&)>& where);
+  bool carried_off(std::size_t i) const { return carried_off_.at(i); }
   Eigen::Vector3d TubeCentreOfMass(std::size_t i) const { return CentreOfMass(tubes_.at(i)); }
 
  private:
@@ -110,6 +121,7 @@ class SimWorld {
   std::unique_ptr<physics::BulletWorld> world_;
   std::vector<btRigidBody*> static_bodies_;
   std::vector<SimTube> tubes_;
+  std::vector<bool> carried_off_;
   btRigidBody* hand_ = nullptr;
   btRigidBody* pads_[2] = {nullptr, nullptr};
   std::vector<std::unique_ptr<Grasp>> grasps_;

@@ -1,5 +1,6 @@
 #include "clients/cell/cell_controller.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <thread>
@@ -694,12 +695,31 @@ TEST_F(CellControllerTest, MostlySpikesInEveryMeasurementAreAForceTorqueFault) {
             std::string::npos)
       << result.message;
   EXPECT_EQ(ft.reads, 9);
+  // A median load of 0.1 N: the sensor, not the payload.
+  EXPECT_NE(result.message.find("their median load is 0.1 N: a loose cable"), std::string::npos) << result.message;
   params.ft_unsettled_retries = 0;  // the old behaviour: the first such measurement is a fault
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   ft.readings = {Reading(0.10), Reading(9.0), Reading(-9.0)};
   const CellRunResult at_once = Run();
   ASSERT_TRUE(at_once.fault);
   EXPECT_NE(at_once.message.find("in each of 1 measurements"), std::string::npos) << at_once.message;
+}
+
+TEST_F(CellControllerTest, ReadingsThatDisagreeUnderAHeavyLoadNamePressingOnSomething) {
+  params.ft_samples = 3;
+  params.ft_unsettled_retries = 0;
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  // The tool pressing into something that gives way: hundreds of newtons, drifting by 6 N.
+  ft.readings = {Reading(444.0), Reading(450.0), Reading(456.0)};
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  const double tube_weight = cell.tube.mass * 9.81;
+  EXPECT_NE(result.message.find(fmt::format("their median load is 450.0 N, {:.0f} times a tube's weight: the "
+                                            "tool or the held tube is pressing on something",
+                                            450.0 / tube_weight)),
+            std::string::npos)
+      << result.message;
 }
 
 TEST_F(CellControllerTest, AMeasurementOfASwingingPayloadIsTakenAgainAfterSettling) {

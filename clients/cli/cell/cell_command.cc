@@ -43,6 +43,7 @@ struct CellOptions {
   std::uint32_t tubes = 7;
   std::string material = "pvc";
   std::string shapes;  ///< --shapes: A, B or C; empty = the material's thesis set (pvc A, rubber B)
+  std::string place_zone = "conveyor";  ///< --place-zone: conveyor or table
   std::string server = "auto";
   std::uint64_t seed = 1;
   std::string records_path;
@@ -302,6 +303,7 @@ void Run(const CellOptions& o) {
         devices::sim::SimCellParams::Thesis(material, o.tubes, o.seed + round);
     if (custom_cell) sim_params.cell = cell_config;
     if (!o.shapes.empty()) WithShapes(o.shapes, &sim_params);
+    sim_params.place_zone_conveyor = o.place_zone == "conveyor";
     if (server) {
       server->AwaitBack();
       server->StartAgain();  // an outage the last round ended in
@@ -352,6 +354,7 @@ void Run(const CellOptions& o) {
   WriteJson(o.json_path, json{{"material", o.material},
                               {"shapes", o.shapes.empty() ? (o.material == "rubber" ? "B" : "A") : o.shapes},
                               {"tubes", o.tubes},
+                              {"place_zone", o.place_zone},
                               {"seed", o.seed},
                               {"rounds", rounds_json},
                               {"faults", campaign.Json(o.fault_rate, o.fault_seed)},
@@ -400,6 +403,11 @@ void AddCellCommand(CLI::App& app) {
          "pvc and jointed link chains in rubber; "
          "default: A for pvc, B for rubber")
       ->check(CLI::IsMember({"A", "B", "C", "CY"}));
+  cmd->add_option("--place-zone", o->place_zone,
+                  "The simulated place zone: a conveyor that carries each placed tube off before the next scan, "
+                  "or a table where placed tubes pile up")
+      ->check(CLI::IsMember({"conveyor", "table"}))
+      ->capture_default_str();
   cmd->add_option("--server", o->server,
                   "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
       ->capture_default_str();

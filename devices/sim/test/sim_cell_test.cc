@@ -226,6 +226,55 @@ TEST(SimCell, TubeDroppedBesideThePlaceZoneCountsAsElsewhere) {
   EXPECT_EQ(cell.TubesElsewhere(), 1u);
 }
 
+/// A tube at rest on the place zone (along x under the place frame's origin) and one in the bin.
+std::vector<physics::TubeGeometry> PlacedAndInBin(const SimCellParams& params) {
+  const double r = params.cell.tube.radius;
+  physics::TubeGeometry placed = StraightTube(1, r, 0.5, params.cell.place.X_BinPlace.translation().y());
+  return {placed, StraightTube(2, r, 0.5)};
+}
+
+TEST(SimCell, ThePlaceZoneConveyorCarriesOffPlacedTubesBeforeEachScan) {
+  SimCellParams params;
+  SimCell cell(params, PlacedAndInBin(params));
+  ASSERT_EQ(cell.TubesInPlaceZone(), 1u);
+  EXPECT_EQ(cell.TubesCarriedOff(), 0u);
+  cell.scanner().Scan(kLong);
+  EXPECT_EQ(cell.TubesCarriedOff(), 1u);
+  // Still counted as placed, where it was carried off; the tube in the bin stays.
+  EXPECT_EQ(cell.TubesInPlaceZone(), 1u);
+  EXPECT_EQ(cell.TubesInBin(), 1u);
+  EXPECT_EQ(cell.TubesElsewhere(), 0u);
+  EXPECT_EQ(cell.TubesBin().size(), 2u);
+  cell.scanner().Scan(kLong);
+  EXPECT_EQ(cell.TubesCarriedOff(), 1u);
+
+  SimCellParams table = params;
+  table.place_zone_conveyor = false;
+  SimCell piled(table, PlacedAndInBin(table));
+  piled.scanner().Scan(kLong);
+  EXPECT_EQ(piled.TubesCarriedOff(), 0u);
+  EXPECT_EQ(piled.TubesInPlaceZone(), 1u);
+}
+
+TEST(SimCell, TheConveyorLeavesAHeldTubeOverThePlaceZone) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  GraspAndLift(cell);
+  Eigen::Isometry3d X_over = cell.X_BinTcp();
+  X_over.translation() = params.cell.place.X_BinPlace.translation() + Eigen::Vector3d(0, 0, 0.1);
+  cell.robot().MoveTo(X_over, 0.25, kLong);
+  cell.Advance(1.0);  // held still: the tube is at rest in the gripper
+  cell.scanner().Scan(kLong);
+  EXPECT_EQ(cell.TubesCarriedOff(), 0u);
+  EXPECT_EQ(cell.HeldTubes().size(), 1u);
+  // Released, at rest on the zone: the next scan's conveyor takes it.
+  cell.gripper().Open(kLong);
+  cell.Advance(2.0);
+  cell.scanner().Scan(kLong);
+  EXPECT_EQ(cell.TubesCarriedOff(), 1u);
+  EXPECT_EQ(cell.TubesInPlaceZone(), 1u);
+}
+
 TEST(SimCell, ArmedRobotAlarmStopsTheMotionAndTheServo) {
   SimCellParams params;
   SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
