@@ -146,6 +146,14 @@ void DescribeFields(Visit& v, EndRoomParams& p) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, JunctionCompletionParams& p) {
+  v("enabled", p.enabled, "false: ends left after the nodes and links are not tried again");
+  v("max_gap", p.max_gap, "as max_gap and side_max_gap, for the ends tried again, m");
+  v("max_axis_offset", p.max_axis_offset, "as max_axis_offset and side_max_axis_offset, for them, m");
+  v("max_length_share", p.max_length_share, "no tree they make longer than this share of tube.length");
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, JunctionParams& p) {
   v("max_gap", p.max_gap, "Y-pieces: each free end's axis is extended by its radius plus this, m");
   v("max_axis_offset", p.max_axis_offset, "Y-pieces: between two extended axes where they meet, m");
@@ -167,6 +175,7 @@ void DescribeFields(Visit& v, JunctionParams& p) {
   v("auto_min_per_tube", p.auto_min_per_tube, "topology auto: and this many per tube they leave");
   v("auto_min_y_pieces", p.auto_min_y_pieces, "topology auto: or this many Y-pieces");
   v.Section("end_room", p.end_room);
+  v.Section("completion", p.completion);
 }
 
 template <typename Visit>

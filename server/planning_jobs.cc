@@ -27,6 +27,7 @@ ModelingResult Model(const PlanningJob& job, const RawRegion& raw_region_Bin, st
   input.bin = job.cell.bin;
   input.topology = job.cell.tube.topology;
   input.junction_shape = job.cell.tube.junction_shape;
+  input.tube_length = job.cell.tube.length;
   input.seed = job.seed;
   ModelingParams params = job.params.modeling;
   params.threads = threads;

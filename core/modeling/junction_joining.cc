@@ -230,6 +230,9 @@ struct Accepted {
   std::vector<std::size_t> node_of_junction;
   std::map<std::uint32_t, std::vector<HostNode>> nodes_of_host;
   std::vector<MeetingNode> meetings;
+  // Of them, accepted by the completion (the last T-pieces and links).
+  std::uint32_t completed_sides = 0;
+  std::uint32_t completed_links = 0;
 };
 
 // Groups end meetings, cheapest first, into nodes of free ends whose meeting points lie within
@@ -296,67 +299,118 @@ std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<T
   return best;
 }
 
-Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
-                const std::vector<Junction>& candidates, const JunctionParams& params, JunctionShape shape,
-                const StopToken* stop) {
-  Forest forest(chains);
-  std::vector<std::array<bool, 2>> end_used(chains.size(), {false, false});
-  Accepted out;
-  // Y-pieces first: their ends are spoken for; then T-pieces; then end-to-end links.
-  auto accept_meeting = [&](const MeetingNode& meeting) {
+// Accepts nodes one by one while every tube stays a tree (union-find over chains), each free
+// end is used once, no node exceeds its branches and no tube the given length.
+class Acceptance {
+ public:
+  Acceptance(const std::vector<Tube>& chains, const JunctionParams& params, JunctionShape shape)
+      : chains_(chains), params_(params), shape_(shape), forest_(chains), end_used_(chains.size()) {}
+
+  // A Y-piece (three or more ends) or a link (two).
+  bool Meeting(const MeetingNode& meeting, double max_length) {
     const std::optional<MeetingNode> fitting =
-        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains, shape, params.shape_tolerance) : meeting;
-    if (!fitting) return;
+        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains_, shape_, params_.shape_tolerance) : meeting;
+    if (!fitting) return false;
     const MeetingNode& n = *fitting;
     std::vector<std::uint32_t> roots;
     double links = 0.0;
     for (const auto& [chain, at_end] : n.ends) {
-      roots.push_back(forest.Find(chain));
-      links += (FreeEndOf(chains[chain], at_end).p - n.Centre()).norm();
+      if (Used(chain, at_end)) return false;
+      roots.push_back(forest_.Find(chain));
+      links += (FreeEndOf(chains_[chain], at_end).p - n.Centre()).norm();
     }
     std::sort(roots.begin(), roots.end());
-    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return;  // a cycle
-    for (const auto& [chain, at_end] : n.ends) {
-      if (end_used[chain][at_end ? 1 : 0]) return;
-    }
+    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return false;  // a cycle
     double length = links;
-    for (const std::uint32_t r : roots) length += forest.Length(r);
-    if (params.max_tube_length > 0.0 && length > params.max_tube_length) return;
-    for (std::size_t k = 1; k < n.ends.size(); ++k) forest.Unite(n.ends[0].first, n.ends[k].first, 0.0);
-    forest.AddLength(n.ends[0].first, links);
-    for (const auto& [chain, at_end] : n.ends) end_used[chain][at_end ? 1 : 0] = true;
-    out.meetings.push_back(n);
-  };
-  for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() >= 3) accept_meeting(n);
+    for (const std::uint32_t r : roots) length += forest_.Length(r);
+    if (max_length > 0.0 && length > max_length) return false;
+    for (std::size_t k = 1; k < n.ends.size(); ++k) forest_.Unite(n.ends[0].first, n.ends[k].first, 0.0);
+    forest_.AddLength(n.ends[0].first, links);
+    for (const auto& [chain, at_end] : n.ends) Use(chain, at_end);
+    out_.meetings.push_back(n);
+    return true;
   }
-  for (const Junction& j : candidates) {
-    ThrowIfStopped(stop, "joining");
-    if (end_used[j.branch][j.at_end ? 1 : 0] || forest.Find(j.branch) == forest.Find(j.host)) continue;
-    const double link = (j.p_Bin - FreeEndOf(chains[j.branch], j.at_end).p).norm();
-    if (params.max_tube_length > 0.0 &&
-        forest.Length(j.branch) + forest.Length(j.host) + link > params.max_tube_length) {
-      continue;
-    }
-    const double arc = j.host_arc;
-    std::vector<HostNode>& nodes = out.nodes_of_host[j.host];
-    auto near = std::find_if(nodes.begin(), nodes.end(),
-                             [&](const HostNode& n) { return std::abs(n.arc - arc) < params.node_spacing; });
-    const std::uint32_t max_branches = shape == JunctionShape::kAny ? params.max_branches_per_node : 3;
-    if (near != nodes.end() && near->degree + 1 > max_branches) continue;
+
+  // A T-piece: the branch's free end on the host's side.
+  bool Side(const Junction& j, double max_length) {
+    if (Used(j.branch, j.at_end) || forest_.Find(j.branch) == forest_.Find(j.host)) return false;
+    const double link = (j.p_Bin - FreeEndOf(chains_[j.branch], j.at_end).p).norm();
+    if (max_length > 0.0 && forest_.Length(j.branch) + forest_.Length(j.host) + link > max_length) return false;
+    std::vector<HostNode>& nodes = out_.nodes_of_host[j.host];
+    auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
+      return std::abs(n.arc - j.host_arc) < params_.node_spacing;
+    });
+    const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
+    if (near != nodes.end() && near->degree + 1 > max_branches) return false;
     if (near == nodes.end()) {
-      nodes.push_back(HostNode{arc, j.host_position, j.p_Bin, 2});
+      nodes.push_back(HostNode{j.host_arc, j.host_position, j.p_Bin, 2});
       near = nodes.end() - 1;
     }
     ++near->degree;
-    end_used[j.branch][j.at_end ? 1 : 0] = true;
-    forest.Unite(j.branch, j.host, link);
-    out.junctions.push_back(j);
-    out.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
+    Use(j.branch, j.at_end);
+    forest_.Unite(j.branch, j.host, link);
+    out_.junctions.push_back(j);
+    out_.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
+    return true;
+  }
+
+  Accepted Take() && { return std::move(out_); }
+
+ private:
+  bool Used(std::uint32_t chain, bool at_end) const { return end_used_[chain][at_end ? 1 : 0]; }
+  void Use(std::uint32_t chain, bool at_end) { end_used_[chain][at_end ? 1 : 0] = true; }
+
+  const std::vector<Tube>& chains_;
+  const JunctionParams& params_;
+  JunctionShape shape_;
+  Forest forest_;
+  std::vector<std::array<bool, 2>> end_used_;
+  Accepted out_;
+};
+
+// What the completion may still accept: T-pieces and pairs of ends within its wider limits.
+struct CompletionCandidates {
+  std::vector<Junction> sides;
+  std::vector<EndMeeting> pairs;
+};
+
+// Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
+// first; then, within `max_completed_length` (0 = none), the completion's candidates, cheapest
+// first across both kinds.
+Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
+                const std::vector<Junction>& candidates, const CompletionCandidates& completion,
+                double max_completed_length, const JunctionParams& params, JunctionShape shape,
+                const StopToken* stop) {
+  Acceptance acceptance(chains, params, shape);
+  for (const MeetingNode& n : meeting_nodes) {
+    if (n.ends.size() >= 3) acceptance.Meeting(n, params.max_tube_length);
+  }
+  for (const Junction& j : candidates) {
+    ThrowIfStopped(stop, "joining");
+    acceptance.Side(j, params.max_tube_length);
   }
   for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() == 2) accept_meeting(n);
+    if (n.ends.size() == 2) acceptance.Meeting(n, params.max_tube_length);
   }
+  std::uint32_t completed_sides = 0, completed_links = 0;
+  if (max_completed_length > 0.0) {
+    std::size_t s = 0, m = 0;
+    const auto& sides = completion.sides;
+    const auto& pairs = completion.pairs;
+    while (s < sides.size() || m < pairs.size()) {
+      ThrowIfStopped(stop, "joining");
+      if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
+        completed_sides += acceptance.Side(sides[s++], max_completed_length) ? 1 : 0;
+      } else {
+        const EndMeeting& pair = pairs[m++];
+        completed_links +=
+            acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true}, max_completed_length) ? 1 : 0;
+      }
+    }
+  }
+  Accepted out = std::move(acceptance).Take();
+  out.completed_sides = completed_sides;
+  out.completed_links = completed_links;
   return out;
 }
 
@@ -520,6 +574,14 @@ void JunctionParams::Validate() const {
   RequireInRange(chain_max_angle, 0.0, kPi, "modeling.junctions.chain_max_angle");
   RequireNonNegative(auto_min_per_tube, "modeling.junctions.auto_min_per_tube");
   end_room.Validate("modeling.junctions.end_room");
+  completion.Validate("modeling.junctions.completion");
+}
+
+void JunctionCompletionParams::Validate(const char* prefix) const {
+  const std::string p(prefix);
+  RequirePositive(max_gap, p + ".max_gap");
+  RequirePositive(max_axis_offset, p + ".max_axis_offset");
+  RequirePositive(max_length_share, p + ".max_length_share");
 }
 
 double ReachOf(const EndRoom& room, double nominal) { return std::min(nominal + room.unfitted, room.free); }
@@ -576,16 +638,30 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
 }
 
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                              JunctionShape shape, const StopToken* stop, const EndRooms& rooms) {
+                              JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
+                              double tube_length) {
   params.Validate();
   ThrowIfStopped(stop, "joining");
-  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
-                                   FindJunctions(chains, params, shape, rooms), params, shape, stop);
+  CompletionCandidates completion;
+  const double max_completed_length = params.completion.enabled && tube_length > 0.0
+                                          ? params.completion.max_length_share * tube_length
+                                          : 0.0;
+  if (max_completed_length > 0.0) {
+    JunctionParams wide = params;
+    wide.max_gap = wide.side_max_gap = params.completion.max_gap;
+    wide.max_axis_offset = wide.side_max_axis_offset = params.completion.max_axis_offset;
+    completion.sides = FindJunctions(chains, wide, shape, rooms);
+    completion.pairs = FindEndMeetings(chains, wide, rooms);
+  }
+  const Accepted accepted =
+      Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+             FindJunctions(chains, params, shape, rooms), completion, max_completed_length, params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
                                                [](const MeetingNode& n) { return n.ends.size() >= 3; }));
-  out.junctions = static_cast<std::uint32_t>(accepted.junctions.size()) + out.y_pieces;
+  out.junctions = static_cast<std::uint32_t>(accepted.junctions.size()) - accepted.completed_sides + out.y_pieces;
+  out.completions = accepted.completed_sides + accepted.completed_links;
 
   // Components (by the smallest chain index in them), in order of that index.
   std::vector<std::uint32_t> component(chains.size());

@@ -248,11 +248,12 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
     const EndRooms rooms =
         MeasureEndRooms(UnfittedPoints(cloud.points, inliers_of), chains, params.junctions.end_room, seen);
-    JunctionJoining joined = JoinJunctions(chains, params.junctions, input.junction_shape, stop, rooms);
+    JunctionJoining joined =
+        JoinJunctions(chains, params.junctions, input.junction_shape, stop, rooms, input.tube_length);
     const bool branched =
         input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
-    spdlog::debug("junctions: {} ({} Y-pieces) joining {} of {} chains into {} tubes; topology {}: {}",
-                  joined.junctions, joined.y_pieces, joined.chains_in_junctions, chains.size(),
+    spdlog::debug("junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
+                  joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
                   joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
     if (branched) {
       result.tubes = std::move(joined.tubes);

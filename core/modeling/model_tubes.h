@@ -33,6 +33,9 @@ struct ModelingInput {
   TubeTopology topology = TubeTopology::kLinear;
   /// The fitting at their junctions (CellConfig tube.junction_shape).
   JunctionShape junction_shape = JunctionShape::kAny;
+  /// The length of one tube (CellConfig tube.length), metres; 0 = unknown. Bounds the junction
+  /// joining's completion (JunctionCompletionParams).
+  double tube_length = 0.0;
 };
 
 struct StageTiming {

@@ -296,12 +296,10 @@ void Run(const EvalOptions& o) {
   const int sources = !o.scenes_dir.empty() + !o.generate.empty() + !o.configs_dir.empty();
   if (sources != 1) throw InvalidArgument("eval: give exactly one of --scenes, --generate, --configs");
   CellConfig cell = LoadCell(o.common);
-  if (!o.topology.empty()) {
-    cell.tube.topology = ParseTubeTopology(o.topology, "--topology");
-    if (!o.generate.empty()) cell.tube.junction_shape = PresetJunctionShape(o.preset);
-  } else if (!o.generate.empty()) {
-    cell = CellForPreset(cell, o.preset);
-  }
+  // Generated scenes: the preset's tube length (and its junction shape); --topology overrides the
+  // preset's topology, not its tubes.
+  if (!o.generate.empty()) cell = CellForPreset(cell, o.preset);
+  if (!o.topology.empty()) cell.tube.topology = ParseTubeTopology(o.topology, "--topology");
   if (!o.junction_shape.empty()) {
     cell.tube.junction_shape = ParseJunctionShape(o.junction_shape, "--junction-shape");
   }

@@ -64,6 +64,7 @@ ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, co
   input.bin = cell.bin;
   input.topology = cell.tube.topology;
   input.junction_shape = cell.tube.junction_shape;
+  input.tube_length = cell.tube.length;
   input.seed = seed;
   return input;
 }

@@ -103,6 +103,7 @@ Stages InProcessCall(const BenchCloud& cloud, const Params& params, std::uint32_
   input.bin = cell.bin;
   input.topology = cell.tube.topology;
   input.junction_shape = cell.tube.junction_shape;
+  input.tube_length = cell.tube.length;
   input.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
   ModelingParams modeling_params = params.modeling;
   modeling_params.threads = threads;

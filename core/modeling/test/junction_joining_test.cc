@@ -151,6 +151,44 @@ TEST(JunctionJoining, TheRoomPastAnEndSetsItsReach) {
   EXPECT_DOUBLE_EQ(ReachOf(EndRoom{0.04, 0.07}, 0.05), 0.07);
 }
 
+TEST(JunctionJoining, EndsLeftOverAreCompletedWithinTheTubeLength) {
+  // A 30 cm run along x; a 10 cm branch along y ending 7 cm from the run's axis: past the T-piece
+  // reach (radius + side_max_gap, 5.25 cm), within the completion's (radius + 8 cm).
+  const Eigen::Vector3d foot(0.16, 0, kR);
+  const std::vector<Tube> chains = {Chain({Cyl({0, 0, kR}, {0.30, 0, kR}, 0)}),
+                                    Chain({Cyl(foot + 0.17 * Dir(90), foot + 0.07 * Dir(90), 1)})};
+  const JunctionParams params;
+  auto join = [&](const std::vector<Tube>& c, double tube_length, const JunctionParams& p = JunctionParams{}) {
+    return JoinJunctions(c, p, JunctionShape::kAny, nullptr, {}, tube_length);
+  };
+  EXPECT_EQ(join(chains, 0.0).tubes.size(), 2u);  // the tube length unknown: no completion
+  const JunctionJoining completed = join(chains, 0.75);
+  ASSERT_EQ(completed.tubes.size(), 1u);
+  EXPECT_TRUE(completed.tubes[0].branched());
+  EXPECT_EQ(completed.completions, 1u);
+  EXPECT_EQ(completed.junctions, 0u);  // never counted towards a branched-looking scene
+  EXPECT_FALSE(LooksBranched(completed, params));
+  // The tree would be 0.30 + 0.10 + 0.07 m: not within a tube of 0.45 m.
+  EXPECT_EQ(join(chains, 0.45).tubes.size(), 2u);
+  EXPECT_EQ(join(chains, 0.48).tubes.size(), 1u);
+  JunctionParams off = params;
+  off.completion.enabled = false;
+  EXPECT_EQ(join(chains, 0.75, off).tubes.size(), 2u);
+  // An axis passing 1.8 cm above the run's (a bent branch fitted straight): past the T-piece's
+  // 1.6 cm, within the completion's 2 cm; 2.4 cm is past both.
+  auto lifted = [&](double dz) {
+    const Eigen::Vector3d up(0, 0, dz);
+    return std::vector<Tube>{chains[0], Chain({Cyl(foot + up + 0.13 * Dir(90), foot + up + 0.03 * Dir(90), 1)})};
+  };
+  EXPECT_EQ(join(lifted(0.018), 0.0).tubes.size(), 2u);
+  EXPECT_EQ(join(lifted(0.018), 0.75).tubes.size(), 1u);
+  EXPECT_EQ(join(lifted(0.024), 0.75).tubes.size(), 2u);
+  off.completion.enabled = true;
+  off.completion.max_axis_offset = 0.0;
+  EXPECT_THAT([&] { join(chains, 0.75, off); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.completion.max_axis_offset")));
+}
+
 TEST(JunctionJoining, TwoArmsOfAYWhoseThirdIsHiddenAreLinkedAcrossAWideKink) {
   // Two arms 50° apart leave a node 2.5 cm from their ends (a kink of 130°); the third arm is
   // hidden. Their axes meet, so they are one tube; the thesis-like 90° limit would leave two.
