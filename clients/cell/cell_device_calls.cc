@@ -60,9 +60,10 @@ std::optional<devices::WrenchReading> MeanWithoutSpikes(const std::vector<device
 std::string LikelyDisagreementCause(double load, double tube_weight) {
   constexpr double kPressingTubes = 10.0;
   if (load > kPressingTubes * tube_weight) {
-    return fmt::format("their median load is {:.1f} N, {:.0f} times a tube's weight: the tool or the held "
-                       "tube is pressing on something, a pile on the place zone or an obstacle?",
-                       load, load / tube_weight);
+    return fmt::format(
+        "their median load is {:.1f} N, {:.0f} times a tube's weight: the tool or the held "
+        "tube is pressing on something, a pile on the place zone or an obstacle?",
+        load, load / tube_weight);
   }
   return fmt::format("their median load is {:.1f} N: a loose cable, a hit tool, a saturated gauge?", load);
 }

@@ -335,7 +335,8 @@ class Acceptance {
   bool Side(const Junction& j, double max_length) {
     if (Used(j.branch, j.at_end) || forest_.Find(j.branch) == forest_.Find(j.host)) return false;
     const double link = (j.p_Bin - FreeEndOf(chains_[j.branch], j.at_end).p).norm();
-    if (max_length > 0.0 && forest_.Length(j.branch) + forest_.Length(j.host) + link > max_length) return false;
+    if (max_length > 0.0 && forest_.Length(j.branch) + forest_.Length(j.host) + link > max_length)
+      return false;
     std::vector<HostNode>& nodes = out_.nodes_of_host[j.host];
     auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
       return std::abs(n.arc - j.host_arc) < params_.node_spacing;
@@ -643,9 +644,8 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
   params.Validate();
   ThrowIfStopped(stop, "joining");
   CompletionCandidates completion;
-  const double max_completed_length = params.completion.enabled && tube_length > 0.0
-                                          ? params.completion.max_length_share * tube_length
-                                          : 0.0;
+  const double max_completed_length =
+      params.completion.enabled && tube_length > 0.0 ? params.completion.max_length_share * tube_length : 0.0;
   if (max_completed_length > 0.0) {
     JunctionParams wide = params;
     wide.max_gap = wide.side_max_gap = params.completion.max_gap;
@@ -653,14 +653,15 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
     completion.sides = FindJunctions(chains, wide, shape, rooms);
     completion.pairs = FindEndMeetings(chains, wide, rooms);
   }
-  const Accepted accepted =
-      Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
-             FindJunctions(chains, params, shape, rooms), completion, max_completed_length, params, shape, stop);
+  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+                                   FindJunctions(chains, params, shape, rooms), completion,
+                                   max_completed_length, params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
                                                [](const MeetingNode& n) { return n.ends.size() >= 3; }));
-  out.junctions = static_cast<std::uint32_t>(accepted.junctions.size()) - accepted.completed_sides + out.y_pieces;
+  out.junctions =
+      static_cast<std::uint32_t>(accepted.junctions.size()) - accepted.completed_sides + out.y_pieces;
   out.completions = accepted.completed_sides + accepted.completed_links;
 
   // Components (by the smallest chain index in them), in order of that index.

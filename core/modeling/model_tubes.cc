@@ -252,9 +252,10 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
         JoinJunctions(chains, params.junctions, input.junction_shape, stop, rooms, input.tube_length);
     const bool branched =
         input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
-    spdlog::debug("junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
-                  joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
-                  joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
+    spdlog::debug(
+        "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
+        joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
+        joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
     if (branched) {
       result.tubes = std::move(joined.tubes);
     } else {

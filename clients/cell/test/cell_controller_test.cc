@@ -696,7 +696,8 @@ TEST_F(CellControllerTest, MostlySpikesInEveryMeasurementAreAForceTorqueFault) {
       << result.message;
   EXPECT_EQ(ft.reads, 9);
   // A median load of 0.1 N: the sensor, not the payload.
-  EXPECT_NE(result.message.find("their median load is 0.1 N: a loose cable"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("their median load is 0.1 N: a loose cable"), std::string::npos)
+      << result.message;
   params.ft_unsettled_retries = 0;  // the old behaviour: the first such measurement is a fault
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   ft.readings = {Reading(0.10), Reading(9.0), Reading(-9.0)};

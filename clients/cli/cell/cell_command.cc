@@ -403,9 +403,10 @@ void AddCellCommand(CLI::App& app) {
          "pvc and jointed link chains in rubber; "
          "default: A for pvc, B for rubber")
       ->check(CLI::IsMember({"A", "B", "C", "CY"}));
-  cmd->add_option("--place-zone", o->place_zone,
-                  "The simulated place zone: a conveyor that carries each placed tube off before the next scan, "
-                  "or a table where placed tubes pile up")
+  cmd->add_option(
+         "--place-zone", o->place_zone,
+         "The simulated place zone: a conveyor that carries each placed tube off before the next scan, "
+         "or a table where placed tubes pile up")
       ->check(CLI::IsMember({"conveyor", "table"}))
       ->capture_default_str();
   cmd->add_option("--server", o->server,

@@ -158,7 +158,8 @@ TEST(JunctionJoining, EndsLeftOverAreCompletedWithinTheTubeLength) {
   const std::vector<Tube> chains = {Chain({Cyl({0, 0, kR}, {0.30, 0, kR}, 0)}),
                                     Chain({Cyl(foot + 0.17 * Dir(90), foot + 0.07 * Dir(90), 1)})};
   const JunctionParams params;
-  auto join = [&](const std::vector<Tube>& c, double tube_length, const JunctionParams& p = JunctionParams{}) {
+  auto join = [&](const std::vector<Tube>& c, double tube_length,
+                  const JunctionParams& p = JunctionParams{}) {
     return JoinJunctions(c, p, JunctionShape::kAny, nullptr, {}, tube_length);
   };
   EXPECT_EQ(join(chains, 0.0).tubes.size(), 2u);  // the tube length unknown: no completion
@@ -178,15 +179,17 @@ TEST(JunctionJoining, EndsLeftOverAreCompletedWithinTheTubeLength) {
   // 1.6 cm, within the completion's 2 cm; 2.4 cm is past both.
   auto lifted = [&](double dz) {
     const Eigen::Vector3d up(0, 0, dz);
-    return std::vector<Tube>{chains[0], Chain({Cyl(foot + up + 0.13 * Dir(90), foot + up + 0.03 * Dir(90), 1)})};
+    return std::vector<Tube>{chains[0],
+                             Chain({Cyl(foot + up + 0.13 * Dir(90), foot + up + 0.03 * Dir(90), 1)})};
   };
   EXPECT_EQ(join(lifted(0.018), 0.0).tubes.size(), 2u);
   EXPECT_EQ(join(lifted(0.018), 0.75).tubes.size(), 1u);
   EXPECT_EQ(join(lifted(0.024), 0.75).tubes.size(), 2u);
   off.completion.enabled = true;
   off.completion.max_axis_offset = 0.0;
-  EXPECT_THAT([&] { join(chains, 0.75, off); },
-              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.completion.max_axis_offset")));
+  EXPECT_THAT(
+      [&] { join(chains, 0.75, off); },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.completion.max_axis_offset")));
 }
 
 TEST(JunctionJoining, TwoArmsOfAYWhoseThirdIsHiddenAreLinkedAcrossAWideKink) {
