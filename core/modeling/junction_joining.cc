@@ -17,8 +17,10 @@
 // 3. Links: two ends that met alone in step 1 and lie within link_max_distance and link_max_angle
 //    (α + β, as the linear joining) are joined end to end (the node is then dropped again,
 //    WithoutPassThroughNodes).
+// 4. Completion: the free ends still unused, as T-pieces and links within the wider limits of
+//    JunctionCompletionParams, cheapest first, where the tree stays within the cell's tube length.
 // Each is accepted only while every tube stays a tree (union-find over chains), each free end is
-// used once, no node exceeds max_branches_per_node and no tube max_tube_length.
+// used once, no node exceeds max_branches_per_node and no tube max_tube_length (Acceptance).
 
 #include "core/modeling/junction_joining.h"
 
