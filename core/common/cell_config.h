@@ -68,7 +68,8 @@ JunctionShape ParseJunctionShape(const std::string& text, const std::string& fie
 struct TubeConfig {
   /// Tube radius, metres.
   double radius = 0.0125;
-  /// Expected curve length, metres; 0 = unknown.
+  /// Expected curve length, metres (a branched tube: all its branches together); 0 = unknown.
+  /// Branched tubes: junction joining completes no tree past it (JunctionCompletionParams).
   double length = 0.50;
   /// Mass of one tube, kg.
   double mass = 0.055;
