@@ -95,7 +95,7 @@ class SimWorld {
   /// The tubes still in the world (what a scanner can see), in index order.
   std::vector<physics::TubeGeometry> TubesInWorldBin() const;
 
-  /// Takes out of the world every tube that is not held, has been carried off before, lies at
+  /// Takes out of the world every tube that is neither held nor carried off already, lies at
   /// rest and whose centre of mass satisfies `where` (a conveyor carrying placed parts away): its
   /// bodies and joints leave the Bullet world, its pose and index stay. Returns how many.
   std::uint32_t CarryOff(const std::function<bool(const Eigen::Vector3d&)>& where);
