@@ -162,6 +162,8 @@ void DescribeFields(Visit& v, JunctionParams& p) {
   v("min_angle", p.min_angle, "radians, between the branch and the axis it meets");
   v("min_meeting_ends", p.min_meeting_ends, "free ends meeting at one point that make a node");
   v("max_branches_per_node", p.max_branches_per_node);
+  v("max_meeting_ends", p.max_meeting_ends,
+    "shape any: more free ends meeting than this are ambiguous, none of them a Y-node");
   v("shape_tolerance", p.shape_tolerance,
     "junction shape other than any: largest difference of an angle between arms, radians");
   v("node_spacing", p.node_spacing);

@@ -7,7 +7,8 @@
 // 1. Y-pieces (every branch ends at the node): free ends whose axes, each extended by its
 //    radius plus max_gap, meet within max_axis_offset, at an angle of at least min_angle or
 //    facing each other along one line (a run broken at the node), are clustered cheapest first;
-//    a cluster of min_meeting_ends (3) or more ends within node_spacing of its centre is a node.
+//    a cluster of min_meeting_ends (3) or more ends within node_spacing of its centre is a node
+//    (with shape `any`, at most max_meeting_ends: a cluster of more is ambiguous, none of it a node).
 // 2. T-pieces (the run goes on through the node): a free end whose axis, extended by the other
 //    tube's radius plus side_max_gap, passes within side_max_axis_offset of another chain's axis
 //    (a cylinder or a joint of it), at least min_angle off it and not within node_spacing of
@@ -386,7 +387,8 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
                 const StopToken* stop) {
   Acceptance acceptance(chains, params, shape);
   for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() >= 3) acceptance.Meeting(n, params.max_tube_length);
+    const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
+    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, params.max_tube_length);
   }
   for (const Junction& j : candidates) {
     ThrowIfStopped(stop, "joining");
@@ -562,6 +564,11 @@ void JunctionParams::Validate() const {
     throw InvalidArgument(
         "modeling.junctions.max_branches_per_node: " + std::to_string(max_branches_per_node) +
         " is below 3 (a junction joins at least three branches)");
+  }
+  if (max_meeting_ends < 3 || max_meeting_ends > max_branches_per_node) {
+    throw InvalidArgument("modeling.junctions.max_meeting_ends: " + std::to_string(max_meeting_ends) +
+                          " is out of range [3, max_branches_per_node = " +
+                          std::to_string(max_branches_per_node) + "]");
   }
   if (min_meeting_ends < 2 || min_meeting_ends > max_branches_per_node) {
     throw InvalidArgument(

@@ -55,6 +55,13 @@ struct JunctionParams {
   /// Most branches meeting at one node (3 = T- and Y-pieces only). A junction shape other than
   /// `any` allows three.
   std::uint32_t max_branches_per_node = 4;
+  /// Junction shape `any`: most free ends one Y-node may take. Where more meet (up to
+  /// max_branches_per_node are gathered), which of them belong together cannot be told, so none
+  /// makes a node: the ends are left to the T-pieces, links and the completion. On generated
+  /// set-C bins every 4-end node was wrong (5 of 5); 3 took them from 65.0 to 65.5 % correct
+  /// (other seeds 56.5 → 57.5 %, set CY with `any` 59.0 → 60.5 %, docs/ACCURACY.md). 4 accepts
+  /// X-pieces. A shape other than `any` keeps the three ends that fit it best instead.
+  std::uint32_t max_meeting_ends = 3;
   /// A junction shape other than `any` (tube.junction_shape): largest difference between an
   /// angle between two of the junction's arms and the shape's, radians. The arms are the
   /// branches' axes at the node; a run cut at a T-junction gives two, each from the node to the

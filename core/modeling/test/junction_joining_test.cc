@@ -236,8 +236,19 @@ TEST(JunctionJoining, AWyeTakesTheThreeEndsThatFitItAndLeavesAChanceFourth) {
   // A fourth tube's end meets the node too, 35° from one arm.
   const Eigen::Vector3d d = Dir(90.0 + 35.0);
   chains.push_back(Chain({Cyl(node + 0.20 * d, node + 0.025 * d, 3)}));
+  // Any shape: which three of the four belong together cannot be told, so no node is made ...
   const JunctionJoining any = JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny);
-  ASSERT_EQ(any.tubes.size(), 1u);  // any shape: a node of four branches
+  EXPECT_EQ(any.y_pieces, 0u);
+  EXPECT_EQ(any.tubes.size(), 4u);
+  // ... unless the cell expects X-pieces: a node of four branches.
+  JunctionParams crosses;
+  crosses.max_meeting_ends = 4;
+  const JunctionJoining x = JoinJunctions(chains, crosses, JunctionShape::kAny);
+  ASSERT_EQ(x.tubes.size(), 1u);
+  EXPECT_EQ(x.y_pieces, 1u);
+  crosses.max_meeting_ends = 5;  // more than max_branches_per_node gathers
+  EXPECT_THAT([&] { JoinJunctions(chains, crosses); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_meeting_ends: 5")));
   const JunctionJoining wye = JoinJunctions(chains, JunctionParams{}, JunctionShape::kWye);
   ASSERT_EQ(wye.tubes.size(), 2u);
   EXPECT_EQ(wye.y_pieces, 1u);
