@@ -566,9 +566,9 @@ void JunctionParams::Validate() const {
         " is below 3 (a junction joins at least three branches)");
   }
   if (max_meeting_ends < 3 || max_meeting_ends > max_branches_per_node) {
-    throw InvalidArgument("modeling.junctions.max_meeting_ends: " + std::to_string(max_meeting_ends) +
-                          " is out of range [3, max_branches_per_node = " +
-                          std::to_string(max_branches_per_node) + "]");
+    throw InvalidArgument(
+        "modeling.junctions.max_meeting_ends: " + std::to_string(max_meeting_ends) +
+        " is out of range [3, max_branches_per_node = " + std::to_string(max_branches_per_node) + "]");
   }
   if (min_meeting_ends < 2 || min_meeting_ends > max_branches_per_node) {
     throw InvalidArgument(
