@@ -7,6 +7,7 @@
 #include "tests/cli_test_support.h"
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 namespace tubepick {
@@ -90,6 +91,31 @@ TEST(CliEval, SceneThenEvalWritesAConsistentReport) {
                 HasSubstr(fmt::format("{} of {} tubes correct", scene["correct"].get<int>(),
                                       scene["tube_count"].get<int>())));
   }
+  fs::remove_all(dir);
+}
+
+TEST(CliEval, PublishedConfigurationsAreModeledWithTheirTubesLength) {
+  // One tree of set C (0.75 m of curve in its edges): without --cell the scene's tube.length is its
+  // tubes' median length, not the default cell's 0.5 m; with --cell it is the cell's.
+  const fs::path dir = TempDir("configs");
+  fs::create_directories(dir / "configs");
+  fs::copy_file(fs::path(TUBEPICK_SOURCE_DIR) / "tests/data/C1_1_tube_configurations.txt",
+                dir / "configs" / "1.txt");
+  const std::string common = "eval --configs " + (dir / "configs").string() +
+                             " --topology branched --view-points 0 --pictures-per-count 0 --report ";
+  const CliRun own = RunCli(common + (dir / "own").string());
+  ASSERT_EQ(own.exit_code, 0) << own.output;
+  const nlohmann::json j = nlohmann::json::parse(ReadText(dir / "own" / "report.json"));
+  ASSERT_EQ(j["scenes"].size(), 1u);
+  EXPECT_NEAR(j["scenes"][0]["tube_length"].get<double>(), 0.75, 0.01);
+  EXPECT_EQ(j["scenes"][0]["correct"], 1);
+
+  std::ofstream(dir / "cell.yaml") << "tube:\n  length: 0.6\n";
+  const CliRun given = RunCli(common + (dir / "given").string() + " --cell " + (dir / "cell.yaml").string());
+  ASSERT_EQ(given.exit_code, 0) << given.output;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(ReadText(dir / "given" / "report.json"))["scenes"][0]["tube_length"]
+                       .get<double>(),
+                   0.6);
   fs::remove_all(dir);
 }
 

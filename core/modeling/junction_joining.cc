@@ -379,23 +379,23 @@ struct CompletionCandidates {
 };
 
 // Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
-// first; then, within `max_completed_length` (0 = none), the completion's candidates, cheapest
-// first across both kinds.
+// first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
+// completion's candidates, cheapest first across both kinds.
 Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
                 const std::vector<Junction>& candidates, const CompletionCandidates& completion,
-                double max_completed_length, const JunctionParams& params, JunctionShape shape,
-                const StopToken* stop) {
+                double max_length, double max_completed_length, const JunctionParams& params,
+                JunctionShape shape, const StopToken* stop) {
   Acceptance acceptance(chains, params, shape);
   for (const MeetingNode& n : meeting_nodes) {
     const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
-    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, params.max_tube_length);
+    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length);
   }
   for (const Junction& j : candidates) {
     ThrowIfStopped(stop, "joining");
-    acceptance.Side(j, params.max_tube_length);
+    acceptance.Side(j, max_length);
   }
   for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() == 2) acceptance.Meeting(n, params.max_tube_length);
+    if (n.ends.size() == 2) acceptance.Meeting(n, max_length);
   }
   std::uint32_t completed_sides = 0, completed_links = 0;
   if (max_completed_length > 0.0) {
@@ -417,6 +417,14 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
   out.completed_sides = completed_sides;
   out.completed_links = completed_links;
   return out;
+}
+
+// The longest tree joining may build (0 = no limit): max_tube_length, and with the cell's tube
+// length known, max_length_share of it.
+double MaxTreeLength(const JunctionParams& params, double tube_length) {
+  if (!(tube_length > 0.0)) return params.max_tube_length;
+  const double share = params.max_length_share * tube_length;
+  return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
 }
 
 // Builds one tree from the chains of a component and the junctions among them.
@@ -578,6 +586,7 @@ void JunctionParams::Validate() const {
   RequireInRange(shape_tolerance, 0.0, kPi, "modeling.junctions.shape_tolerance");
   RequireNonNegative(node_spacing, "modeling.junctions.node_spacing");
   RequireNonNegative(max_tube_length, "modeling.junctions.max_tube_length");
+  RequirePositive(max_length_share, "modeling.junctions.max_length_share");
   RequireNonNegative(chain_max_distance, "modeling.junctions.chain_max_distance");
   RequireNonNegative(link_max_distance, "modeling.junctions.link_max_distance");
   RequireInRange(link_max_angle, 0.0, kPi, "modeling.junctions.link_max_angle");
@@ -662,9 +671,10 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
     completion.sides = FindJunctions(chains, wide, shape, rooms);
     completion.pairs = FindEndMeetings(chains, wide, rooms);
   }
-  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
-                                   FindJunctions(chains, params, shape, rooms), completion,
-                                   max_completed_length, params, shape, stop);
+  const Accepted accepted =
+      Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+             FindJunctions(chains, params, shape, rooms), completion, MaxTreeLength(params, tube_length),
+             max_completed_length, params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),

@@ -90,6 +90,13 @@ struct JunctionParams {
   double link_max_angle = 150.0 * 3.14159265358979323846 / 180.0;
   /// Longest tube (cylinders, joints and junction links) joining may build, metres; 0 = no limit.
   double max_tube_length = 0.80;
+  /// With the cell's tube length known (tube.length > 0), no tree longer than this share of it
+  /// either: a tree a few centimetres longer than one part holds a stranger's fragment, and the
+  /// fitted axes of a whole tree come out within about 3 % of its curve length. On generated
+  /// set-C bins (0.75 m trees) 1.04 took correct tubes from 65.5 to 67.0 % (one pure ≥ 80 %:
+  /// 70.5 → 72.5 %), other seeds and 14 trees a little, set CY with `any` 60.5 → 63.0 %
+  /// (docs/ACCURACY.md); 1.07 (the 0.80 m of max_tube_length) is where it was.
+  double max_length_share = 1.04;
   /// `auto` topology: a scene counts as branched when at least this many junctions are found ...
   std::uint32_t auto_min_junctions = 3;
   /// ... and at least this many per tube they leave: a bin of linear tubes shows a few chance
@@ -158,14 +165,16 @@ struct JunctionJoining {
 /// Joins linear chains (JoinTubes' output) into trees: nodes where three or more free ends meet
 /// (Y-pieces, ClusterMeetings) first, then free ends meeting another chain's side (T-pieces),
 /// cheapest first, while each keeps every tube a tree (no cycle), uses each free end once, gives
-/// no node more than max_branches_per_node branches and keeps the tube within max_tube_length.
+/// no node more than max_branches_per_node branches and keeps the tube within max_tube_length
+/// and max_length_share of `tube_length`.
 /// A host chain is cut at each T-junction on it (the cylinder under it is split at the
 /// junction's foot); every branch end is linked to its node by a joint (TubeJoints). Tubes
 /// without a junction are returned as they came (linear, implicit graph). With a junction shape
 /// other than `any`, every node has three arms whose angles fit the shape. Deterministic.
 /// @throws InvalidArgument for invalid parameters. @throws Cancelled when `stop` fires.
 /// `rooms` (MeasureEndRooms of `chains`; empty = none) sets each free end's reach (ReachOf).
-/// `tube_length` (the cell's tube.length, metres; 0 = unknown) bounds the completion.
+/// `tube_length` (the cell's tube.length, metres; 0 = unknown) bounds every tree
+/// (max_length_share) and the completion (JunctionCompletionParams::max_length_share).
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
                               JunctionShape shape = JunctionShape::kAny, const StopToken* stop = nullptr,
                               const EndRooms& rooms = {}, double tube_length = 0.0);

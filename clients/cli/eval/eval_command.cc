@@ -195,6 +195,15 @@ std::string WriteScenePage(const EvaluatedScene& scene, const Points& points_Sen
   return file;
 }
 
+// The median curve length of a configuration's tubes, metres (0 for none).
+double MedianTubeLength(const std::vector<physics::TubeGeometry>& tubes) {
+  std::vector<double> lengths;
+  for (const physics::TubeGeometry& t : tubes) lengths.push_back(t.Length());
+  if (lengths.empty()) return 0.0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
 EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const CellConfig& default_cell,
                            const Params& params, const EvaluationParams& eval_params) {
   EvaluatedScene out;
@@ -226,6 +235,8 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
     }
     case SceneJob::Kind::kConfiguration: {
       tubes_Bin = physics::ReadTubeConfigurations(job.path);
+      // The configuration says what the cell's tubes are, as a preset does for generated scenes.
+      if (o.common.cell_path.empty()) cell.tube.length = MedianTubeLength(tubes_Bin);
       physics::ScanResult scan = physics::ScanScene(tubes_Bin, cell, physics::ScannerParams{}, o.common.seed);
       points_Sensor = std::move(scan.points_Sensor);
       labels = std::move(scan.labels);
@@ -234,6 +245,7 @@ EvaluatedScene EvaluateJob(const SceneJob& job, const EvalOptions& o, const Cell
     }
   }
   out.tube_count = static_cast<std::uint32_t>(tubes_Bin.size());
+  out.tube_length = cell.tube.length;
   out.input_points = points_Sensor.size();
 
   // Planning needs the raw points of its finger test; the modeling is the same either way.
@@ -420,7 +432,8 @@ void AddEvalCommand(CLI::App& app) {
                                    "Generate scenes with these tube counts: 'A..B', 'N' or 'A,B'");
   auto* configs =
       cmd->add_option("--configs", o->configs_dir,
-                      "Directory of published tube_configurations .txt files (searched recursively)")
+                      "Directory of published tube_configurations .txt files (searched recursively); "
+                      "without --cell, each scene's tube.length is the median length of its tubes")
           ->check(CLI::ExistingDirectory);
   scenes->excludes(generate)->excludes(configs);
   generate->excludes(configs);

@@ -40,6 +40,8 @@ struct EvaluatedScene {
   /// Seed of a generated scene (`tubepick scene --tubes N --seed S` reproduces it); −1 otherwise.
   std::int64_t scene_seed = -1;
   std::uint64_t input_points = 0;
+  /// The cell's tube.length the scene was modeled with, metres (0 = unknown).
+  double tube_length = 0.0;
   SceneEvaluation evaluation;
   SceneSnapshot snapshot;
   /// The best plan against the ground truth (`--plans`).

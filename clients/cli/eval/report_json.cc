@@ -114,6 +114,7 @@ json SceneJson(const EvaluatedScene& s) {
               {"tube_count", s.tube_count},
               {"scene_seed", s.scene_seed >= 0 ? json(s.scene_seed) : json(nullptr)},
               {"input_points", s.input_points},
+              {"tube_length", s.tube_length},
               {"filtered_points", e.filtered_points},
               {"segments", e.segments},
               {"visible_sections", e.visible_sections},

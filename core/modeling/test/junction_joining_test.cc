@@ -123,6 +123,28 @@ TEST(JunctionJoining, LimitsKeepTreesAndSizes) {
       ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_branches_per_node: 2")));
 }
 
+TEST(JunctionJoining, TheCellsTubeLengthBoundsEveryTree) {
+  // The Y is 0.575 m with its links: within 1.04 × 0.56 m (0.582), not within 1.04 × 0.55 m (0.572).
+  const std::vector<Tube> chains = YPiece({0, 0, kR}, 0.025, 0);
+  const JunctionParams params;
+  EXPECT_EQ(JoinJunctions(chains, params, JunctionShape::kAny, nullptr, {}, 0.56).tubes.size(), 1u);
+  // Refused, the Y leaves three ends; the completion then links two arms within 0.55 m.
+  const JunctionJoining refused = JoinJunctions(chains, params, JunctionShape::kAny, nullptr, {}, 0.55);
+  EXPECT_EQ(refused.tubes.size(), 2u);
+  EXPECT_EQ(refused.y_pieces, 0u);
+  EXPECT_EQ(refused.completions, 1u);
+  EXPECT_EQ(JoinJunctions(chains, params, JunctionShape::kAny, nullptr, {}, 0.0).tubes.size(),
+            1u);  // unknown
+  JunctionParams wider = params;
+  wider.max_length_share = 1.05;  // 0.5775
+  EXPECT_EQ(JoinJunctions(chains, wider, JunctionShape::kAny, nullptr, {}, 0.55).tubes.size(), 1u);
+  wider.max_tube_length = 0.57;  // the absolute limit still holds
+  EXPECT_EQ(JoinJunctions(chains, wider, JunctionShape::kAny, nullptr, {}, 0.55).y_pieces, 0u);
+  wider.max_length_share = 0.0;
+  EXPECT_THAT([&] { JoinJunctions(chains, wider); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_length_share")));
+}
+
 TEST(JunctionJoining, TheRoomPastAnEndSetsItsReach) {
   // A run along x; a branch along y whose cylinder ends 8 cm from the run's axis (region growing
   // left its last centimetres unfitted): beyond the T-piece reach (radius + side_max_gap).
