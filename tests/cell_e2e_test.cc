@@ -51,6 +51,8 @@ TEST_F(CellEndToEndTest, ThreePvcTubesAreAllPickedAndPlaced) {
   EXPECT_EQ(r.tubes_in_bin, 0u);
   EXPECT_EQ(r.tubes_outside_bin, 3u);
   EXPECT_EQ(r.run.picks, 3u);
+  EXPECT_EQ(r.tubes_in_place_zone, 3u);
+  EXPECT_EQ(r.tubes_unnoticed, 0u);
   EXPECT_LE(r.run.attempts, 3u * params.max_attempts_per_tube);
   EXPECT_GT(server_->calls_served(), 3u);  // PlanPick per scan + AnalyzeWrench per lift
 
@@ -94,6 +96,27 @@ physics::TubeGeometry StraightTubeAlongX(int id, double radius, double length, d
     tube.edges.push_back(e);
   }
   return tube;
+}
+
+TEST_F(CellEndToEndTest, ATubeOnThePlaceZoneThatNoPickPutThereIsCountedAsCarriedOutUnnoticed) {
+  // One tube in the bin, and one already lying over the place zone as if a pick had carried it out
+  // beside the tube it placed: one pick, two tubes over the zone.
+  devices::sim::SimCellParams sim_params =
+      devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 1, 5);
+  const double r = sim_params.cell.tube.radius;
+  const double y_place = sim_params.cell.place.X_BinPlace.translation().y();
+  devices::sim::SimCell sim(sim_params,
+                            {StraightTubeAlongX(1, r, 0.5, 0.0), StraightTubeAlongX(2, r, 0.5, y_place)});
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+
+  const cli::SimRoundResult result = cli::RunSimRound(planner, sim, {}, 0, &sink);
+
+  EXPECT_EQ(result.run.reason, cell::CellStopReason::kBinEmpty) << result.run.message;
+  EXPECT_EQ(result.run.picks, 1u);
+  EXPECT_EQ(result.tubes_in_place_zone, 2u);
+  EXPECT_EQ(result.tubes_unnoticed, 1u);
+  EXPECT_EQ(result.tubes_elsewhere, 0u);
 }
 
 TEST_F(CellEndToEndTest, TubeAlongALongWallIsNudgedOffItAndPicked) {

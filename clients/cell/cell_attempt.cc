@@ -2,6 +2,8 @@
 // analyze → place | release | resolve → place | release | put back; and the nudge's motions.
 // Poses are X_BinTcp…: the TCP in the bin frame.
 
+#include <algorithm>
+
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 
@@ -11,6 +13,7 @@
 #include "clients/cell/cell_frame_check.h"
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
+#include "core/params.h"
 #include "core/wrench/resolution_hold.h"
 #include "wire/proto_convert.h"
 
@@ -114,7 +117,7 @@ void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& at
   Approach(poses.X_BinTcpPreGrasp, opening_width, attempt);
   const devices::WrenchReading reference = TakeReference(attempt);
   if (!Grasp(poses.X_BinTcpGrasp, attempt)) {
-    ReleaseFailedGrasp(poses.X_BinTcpPreGrasp, attempt);
+    ReleaseFailedGrasp(poses.X_BinTcpGrasp, poses.X_BinTcpPreGrasp, reference, attempt);
     attempt.result = AttemptResult::kGraspFailed;
     return;
   }
@@ -163,11 +166,14 @@ bool CellController::Grasp(const Eigen::Isometry3d& X_BinTcpGrasp, Attempt& atte
   return object;
 }
 
-/// Nothing grasped: open, back up to the pre-grasp pose, home.
-void CellController::ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpPreGrasp, Attempt& attempt) {
+/// Nothing grasped: open, back up to the pre-grasp pose, nothing caught on the tool, home.
+void CellController::ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpGrasp,
+                                        const Eigen::Isometry3d& X_BinTcpPreGrasp,
+                                        const devices::WrenchReading& reference, Attempt& attempt) {
   Enter(CellState::kRelease);
   OpenGripper();
   MoveTo(X_BinTcpPreGrasp, params_.approach_speed, &attempt);
+  CheckToolEmpty(reference, "after_failed_grasp", X_BinTcpGrasp, attempt);
   GoHome(&attempt);
 }
 
@@ -241,7 +247,7 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
       return *result;
   }
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpLift, params_.lift_speed, &attempt);
-  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, attempt);
+  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, reference, attempt);
   return AttemptResult::kMultipleReturned;
 }
 
@@ -352,7 +358,7 @@ void CellController::ReleaseEmpty(Attempt& attempt) {
 }
 
 void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
-                             Attempt& attempt) {
+                             const devices::WrenchReading& reference, Attempt& attempt) {
   Enter(CellState::kReturnToBin);
   // Straight down from the lift pose (its xy was checked against the bin's safety zone by the
   // planner) to just above the grasp height, open, and back up.
@@ -363,21 +369,62 @@ void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen
   OpenGripper();
   if (drop < 0.0)
     MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -drop)}, params_.approach_speed, &attempt);
+  Eigen::Isometry3d X_BinTcpReleased = X_BinTcpLift;
+  X_BinTcpReleased.translation().z() += std::min(drop, 0.0);
+  CheckToolEmpty(reference, "after_put_back", X_BinTcpReleased, attempt);
   GoHome(&attempt);
+}
+
+void CellController::CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
+                                    const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt) {
+  // The same orientation and opening as the reference: whatever the tilt (a nudge leans the tool),
+  // a caught tube adds its weight to the force; more than F_tol of Algorithm 3 is not noise.
+  const WrenchParams wrench = ProfileParams(params_.profile.empty() ? "fast" : params_.profile).wrench;
+  const double tolerance = wrench.force_tolerance;
+  auto extra_load = [&](const std::string& name) {
+    const devices::WrenchReading reading = ReadWrench();
+    attempt.record["wrench"][name] = WrenchJson(reading);
+    return (reading.force - reference.force).norm();
+  };
+  double load = extra_load(key);
+  if (load <= tolerance) return;
+  spdlog::warn("cell: round {}: {:.2f} N on the tool after it let go ({}): lowering it into the bin once",
+               round_, load, key);
+  const Eigen::Isometry3d X_BinTcpUp = CurrentPose();
+  MoveTo(X_BinTcpShed, params_.approach_speed, &attempt);
+  MoveTo(X_BinTcpUp, params_.approach_speed, &attempt);
+  load = extra_load(key + "_again");
+  if (load <= tolerance) return;
+  held_ = Held::kUnknown;
+  caught_reference_ = reference;
+  const double tube_weight = cell_.tube.mass * wrench.gravity;
+  const Eigen::Vector3d p = X_BinTcpUp.translation();
+  throw CellFault(
+      "ft_sensor", FaultKind::kUnexpectedLoad, ToString(state_),
+      fmt::format("the tool carries {:.2f} N ({:.1f} times a tube's weight) after letting go, at "
+                  "X_BinTcp ({:.3f}, {:.3f}, {:.3f}) m, also after lowering it into the bin once: a "
+                  "tube caught on the pads or the housing?",
+                  load, load / tube_weight, p.x(), p.y(), p.z()));
 }
 
 void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {
   Enter(CellState::kNudge);
-  // Closed pads (nothing between them: the gripper is at home) make one narrow block.
-  CloseGripper();
   Eigen::Isometry3d X_BinTcpAbovePress = plan.X_BinTcpPress;
   X_BinTcpAbovePress.translation().z() += params_.approach_height;
   TransitTo(X_BinTcpAbovePress, &attempt);
+  // The reference with the gripper open, as it will be after the push; then closed pads (nothing
+  // between them: approach_height above the tube) make one narrow block.
+  const devices::WrenchReading reference = ReadWrench();
+  attempt.record["wrench"] = {{"reference", WrenchJson(reference)}};
+  CloseGripper();
   MoveTo(plan.X_BinTcpPress, params_.approach_speed, &attempt);
   MoveThrough(NudgePushWaypoints(plan), params_.nudge.speed, &attempt);
+  const Eigen::Isometry3d X_BinTcpPushed = CurrentPose();
   MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, params_.approach_height)},
               params_.approach_speed, &attempt);
   OpenGripper();
+  // A hose can hook over a pad while it is pushed: it must not ride home.
+  CheckToolEmpty(reference, "after_nudge", X_BinTcpPushed, attempt);
   GoHome(&attempt);
 }
 

@@ -171,6 +171,7 @@ CellRunResult CellController::Run(std::uint32_t round) {
   commanded_ = false;
   dry_run_ = false;
   held_ = Held::kUnknown;
+  caught_reference_.reset();
   RunState run;
   const nlohmann::json truth_start = Truth();
   const std::optional<StopCause> cause = Guarded([&] {

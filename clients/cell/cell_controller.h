@@ -68,7 +68,9 @@ struct SafeStopOutcome {
   /// What the gripper held when the fault stopped the run.
   Held held = Held::kNothing;
   /// "stopped" (nothing held: no motion), "released_in_bin" (moved over the bin and opened),
-  /// "kept_closed" (the arm could not move, or the gripper could not open: the tube is still held).
+  /// "kept_closed" (the arm could not move, or the gripper could not open: the tube is still held),
+  /// "load_on_tool" (opened over the bin, but what was caught on the tool still hangs there: the
+  /// arm stays at the release pose inside the bin).
   std::string action = "stopped";
   /// The TCP where the safe stop ended, bin frame (nullopt: the robot did not report it).
   std::optional<Eigen::Vector3d> p_Bin_tcp;
@@ -330,6 +332,10 @@ class CellController {
   std::string ReturnHeldTubeToBin(SafeStopOutcome& outcome);
   /// The release pose over the bin's middle, x_Tcp turned (about the vertical) along the bin's long
   /// side so that the held tube hangs along it.
+  /// After the safe stop opened over the bin: what still hangs on the tool (against
+  /// caught_reference_, above F_tol; an F/T that does not answer cannot say it fell off), or
+  /// nullopt when nothing was caught or it fell off. Never throws.
+  std::optional<std::string> LoadStillCaught();
   Eigen::Isometry3d SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const;
 
   // One picking attempt (cell_attempt.cc): approach, reference, grasp, lift, analyze, then place,
@@ -346,7 +352,8 @@ class CellController {
   devices::WrenchReading TakeReference(Attempt& attempt);
   /// Down to the grasp pose and close; whether the gripper reports an object.
   bool Grasp(const Eigen::Isometry3d& X_BinTcpGrasp, Attempt& attempt);
-  void ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpPreGrasp, Attempt& attempt);
+  void ReleaseFailedGrasp(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpPreGrasp,
+                          const devices::WrenchReading& reference, Attempt& attempt);
   /// Along the plan's waypoints; returns the lift pose.
   Eigen::Isometry3d Lift(const std::vector<Eigen::Vector3d>& waypoints_Bin, Attempt& attempt);
   /// The reading at the lift pose (into `lifted`) and its analysis.
@@ -379,7 +386,15 @@ class CellController {
   void ReleaseEmpty(Attempt& attempt);
   /// Several tubes held after every resolution motion: lower them back into the bin and open.
   void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
-               Attempt& attempt);
+               const devices::WrenchReading& reference, Attempt& attempt);
+  /// Before the tool leaves the bin empty-handed (after a failed grasp, a put-back, a nudge): a
+  /// reading against `reference` (the same gripper opening and orientation) that must weigh
+  /// nothing, into record["wrench"][key]. A tube caught on the pads or the housing is not carried
+  /// home: the tool goes down to `X_BinTcpShed` (where it just was, inside the bin) and back up
+  /// once; still loaded, it throws CellFault (ft_sensor, unexpected_load) with the tool over the
+  /// bin and held_ unknown, so the safe stop lowers it over the bin's middle and opens there.
+  void CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
+                      const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt);
   /// The nudge skill's motions (kNudge), from home back to home.
   void ExecuteNudge(const NudgePlan& plan, Attempt& attempt);
   void GoHome(Attempt* attempt);
@@ -433,6 +448,9 @@ class CellController {
   std::function<void(CellState)> observer_;
   CellState state_ = CellState::kStart;
   Held held_ = Held::kUnknown;
+  /// Set by CheckToolEmpty when something stayed caught on the tool: the empty tool's reading, so
+  /// that the safe stop can tell whether opening over the bin shed it.
+  std::optional<devices::WrenchReading> caught_reference_;
   std::uint32_t round_ = 0;
   /// A stop was requested (RequestStop); stop_why_ (under stop_mutex_) is set before it.
   std::atomic<bool> stop_requested_{false};

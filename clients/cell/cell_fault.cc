@@ -14,6 +14,8 @@ std::string ToString(FaultKind kind) {
       return "server_unavailable";
     case FaultKind::kServerError:
       return "server_error";
+    case FaultKind::kUnexpectedLoad:
+      return "unexpected_load";
     case FaultKind::kInternal:
       return "internal";
   }

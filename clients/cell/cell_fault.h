@@ -17,11 +17,14 @@ enum class FaultKind {
   kServerUnavailable,
   /// The planner rejected the request or gave an unusable answer.
   kServerError,
+  /// The F/T sensor weighs a load where the tool should carry nothing (a tube caught on the pads
+  /// or the housing after a failed grasp, a put-back or a nudge).
+  kUnexpectedLoad,
   /// Anything else (a bug): still ends in a safe stop.
   kInternal,
 };
 
-/// "timeout", "device_fault", "server_unavailable", "server_error", "internal".
+/// "timeout", "device_fault", "server_unavailable", "server_error", "unexpected_load", "internal".
 std::string ToString(FaultKind kind);
 
 /// A fault the controller cannot recover from. `device` is "scanner", "robot", "gripper",

@@ -10,6 +10,7 @@
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "core/params.h"
 
 namespace tubepick::cell {
 namespace {
@@ -72,6 +73,21 @@ void CellController::SafeStop(const StopCause& cause, CellRunResult& result) {
   if (sink_) sink_->Write(SafeStopRecord(round_, result, cause.state));
 }
 
+std::optional<std::string> CellController::LoadStillCaught() {
+  if (!caught_reference_) return std::nullopt;
+  try {
+    const devices::WrenchReading now = devices_.ft_sensor->Read(params_.ft_timeout);
+    const double load = (now.force - caught_reference_->force).norm();
+    const double tolerance =
+        ProfileParams(params_.profile.empty() ? "fast" : params_.profile).wrench.force_tolerance;
+    if (load <= tolerance) return std::nullopt;
+    return fmt::format("{:.2f} N still hang on the tool", load);
+  } catch (const std::exception& e) {
+    return fmt::format("the F/T sensor did not answer ({}), so what was caught may still hang on the tool",
+                       e.what());
+  }
+}
+
 Eigen::Isometry3d CellController::SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const {
   // Turn about the vertical so that x_Tcp (along the grasped tube) lies along the bin's longer side,
   // by the smaller of the two turns that do.
@@ -123,6 +139,13 @@ std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
   } catch (const std::exception& e) {
     return fmt::format("HOLDING {} over the bin at X_BinTcp {}: the gripper cannot open ({})", what,
                        FormatPosition(*outcome.p_Bin_tcp), e.what());
+  }
+  if (const std::optional<std::string> caught = LoadStillCaught()) {
+    outcome.action = "load_on_tool";
+    return fmt::format(
+        "opened over the bin at X_BinTcp {}, but {}: the arm stays there, inside the bin; take "
+        "it off by hand",
+        FormatPosition(*outcome.p_Bin_tcp), *caught);
   }
   held_ = Held::kNothing;
   outcome.action = "released_in_bin";

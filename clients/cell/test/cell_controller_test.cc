@@ -1,6 +1,7 @@
 #include "clients/cell/cell_controller.h"
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <thread>
@@ -511,6 +512,80 @@ TEST_F(CellControllerTest, RobotFaultDuringANudgeEndsInSafeStopAndIsRecorded) {
   EXPECT_EQ(records[0]["result"], "fault");
   EXPECT_TRUE(records[0].contains("nudge"));
   EXPECT_EQ(records[0]["fault"]["state"], "nudge");
+}
+
+TEST_F(CellControllerTest, ATubeCaughtOnTheToolAfterANudgeIsNotCarriedHome) {
+  // The reference above the press, then 0.60 N more after the push, and still after lowering the
+  // tool into the bin once: a hose hooked over a pad.
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  ft.readings = {Reading(0.02), Reading(0.62), Reading(0.62)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kFault);
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kUnexpectedLoad);
+  EXPECT_EQ(result.fault->state(), "nudge");
+  EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("carries 0.60 N (1.1 times a tube's weight)"));
+  EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("caught on the pads or the housing"));
+  // Not carried home: the safe stop lowered it over the bin's middle and opened there.
+  // Not carried home: the safe stop lowered it over the bin's middle and opened there; the load
+  // still hangs on the tool (the last reading again), so the arm stays there, inside the bin.
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kUnknown);
+  EXPECT_EQ(result.safe_stop->action, "load_on_tool");
+  ASSERT_FALSE(gripper.opened_at.empty());
+  const Eigen::Vector3d p_Bin_release(0.0, 0.0, params.safe_release_height);
+  EXPECT_TRUE(gripper.opened_at.back().isApprox(p_Bin_release, kTol));
+  EXPECT_TRUE(robot.X_BinTcp.translation().isApprox(p_Bin_release, kTol));
+  EXPECT_THAT(result.message, ::testing::HasSubstr("0.60 N still hang on the tool: the arm stays there"));
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["result"], "fault");
+  EXPECT_NEAR(records[0]["wrench"]["after_nudge"]["force"][2].get<double>(), 0.62, kTol);
+  EXPECT_NEAR(records[0]["wrench"]["after_nudge_again"]["force"][2].get<double>(), 0.62, kTol);
+}
+
+TEST_F(CellControllerTest, ALoadThatStaysInTheBinWhenTheToolIsLoweredLetsTheRoundGoOn) {
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  ft.readings = {Reading(0.02), Reading(0.62), Reading(0.03)};  // 0.01 N off: noise
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.nudges, 1u);
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0]["result"], "nudge");
+  EXPECT_TRUE(records[0]["wrench"].contains("after_nudge_again"));
+  // Without a load there is no second reading and no extra motion.
+  ft.readings = {Reading(0.02), Reading(0.04)};
+  sink = MemoryRecordSink{};
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  EXPECT_EQ(Run().reason, CellStopReason::kBinEmpty);
+  EXPECT_FALSE(Records("attempt")[0]["wrench"].contains("after_nudge_again"));
+}
+
+TEST_F(CellControllerTest, ATubeCaughtOnTheOpenFingersAfterAFailedGraspIsNotCarriedHome) {
+  planner.plan_answers.push_back(Plans({MakePlan(0, p_Bin_grasp)}, 1));
+  gripper.close_results.push_back(ClosedOnNothing());
+  ft.readings = {Reading(0.02), Reading(0.60), Reading(0.60)};
+
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->kind(), FaultKind::kUnexpectedLoad);
+  EXPECT_EQ(result.fault->state(), "release");
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "load_on_tool");
+  EXPECT_TRUE(Records("attempt")[0]["wrench"].contains("after_failed_grasp_again"));
+  // Shed when the safe stop opens over the bin: released there, and the arm moves up.
+  ft.readings = {Reading(0.02), Reading(0.60), Reading(0.60), Reading(0.02)};
+  planner.plan_answers.push_back(Plans({MakePlan(0, p_Bin_grasp)}, 1));
+  gripper.close_results.push_back(ClosedOnNothing());
+  const CellRunResult shed = Run();
+  ASSERT_TRUE(shed.safe_stop);
+  EXPECT_EQ(shed.safe_stop->action, "released_in_bin");
+  EXPECT_THAT(shed.message, ::testing::HasSubstr("robot moved up out of the bin"));
 }
 
 TEST_F(CellControllerTest, PerBinLimitCountsAllAttempts) {

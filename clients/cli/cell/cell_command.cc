@@ -323,15 +323,17 @@ void Run(const CellOptions& o) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     fmt::print(
         "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released "
-        "outside, "
+        "outside, {}"
         "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
+        r.tubes_unnoticed > 0 ? fmt::format("{} carried out unnoticed, ", r.tubes_unnoticed) : "",
         result.attempts, result.scans, r.simulated_s, wall);
     std::fflush(stdout);
     json round_json = RoundJson(round, result, wall);
     round_json.update({{"seed", o.seed + round},
                        {"tubes_left", left},
                        {"released_outside", r.tubes_elsewhere},
+                       {"carried_out_unnoticed", r.tubes_unnoticed},
                        {"still_held", r.tubes_held},
                        {"simulated_s", r.simulated_s}});
     rounds_json.push_back(std::move(round_json));

@@ -20,6 +20,7 @@ void FaultCampaign::Add(const SimRoundResult& round, const FaultInjector* inject
     }
   }
   released_outside += round.tubes_elsewhere;
+  carried_out_unnoticed += round.tubes_unnoticed;
   lost_in_transit += run.lost;
   local_analyses += run.local_analyses;
   if (run.reason == cell::CellStopReason::kBinEmpty && round.tubes_in_bin == 0) ++bins_emptied;
@@ -27,8 +28,9 @@ void FaultCampaign::Add(const SimRoundResult& round, const FaultInjector* inject
 
 std::string FaultCampaign::SummaryLine() const {
   return fmt::format(
-      "faults: injected={} safe_stops={} released_outside={} lost_in_transit={} bins_emptied={}/{}", injected,
-      safe_stops, released_outside, lost_in_transit, bins_emptied, rounds);
+      "faults: injected={} safe_stops={} released_outside={} lost_in_transit={} bins_emptied={}/{}{}",
+      injected, safe_stops, released_outside, lost_in_transit, bins_emptied, rounds,
+      carried_out_unnoticed > 0 ? fmt::format(" carried_out_unnoticed={}", carried_out_unnoticed) : "");
 }
 
 std::string FaultCampaign::KindsLine() const {
@@ -52,6 +54,7 @@ nlohmann::json FaultCampaign::Json(double rate, std::uint64_t seed) const {
           {"released_in_bin", released_in_bin},
           {"kept_closed", kept_closed},
           {"released_outside", released_outside},
+          {"carried_out_unnoticed", carried_out_unnoticed},
           {"lost_in_transit", lost_in_transit},
           {"local_analyses", local_analyses},
           {"bins_emptied", bins_emptied}};

@@ -23,6 +23,8 @@ struct FaultCampaign {
   std::uint32_t kept_closed = 0;
   /// Tubes at rest anywhere but the bin, the place zone or the gripper (the world's truth).
   std::uint32_t released_outside = 0;
+  /// Tubes that reached the place zone beyond the picks (SimRoundResult::tubes_unnoticed).
+  std::uint32_t carried_out_unnoticed = 0;
   /// Tubes the controller recorded as lost between grasp and place.
   std::uint32_t lost_in_transit = 0;
   /// AnalyzeWrench answered by the local fallback.
@@ -32,7 +34,8 @@ struct FaultCampaign {
 
   /// Adds one round (`injector` null: no faults were injected in it).
   void Add(const SimRoundResult& round, const FaultInjector* injector);
-  /// "faults: injected=I safe_stops=S released_outside=R lost_in_transit=L bins_emptied=E/N".
+  /// "faults: injected=I safe_stops=S released_outside=R lost_in_transit=L bins_emptied=E/N"
+  /// (and " carried_out_unnoticed=U" when U > 0).
   std::string SummaryLine() const;
   /// "faults by kind: robot_alarm=…, slip=…; safe stops holding a tube: …".
   std::string KindsLine() const;
