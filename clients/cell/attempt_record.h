@@ -65,8 +65,8 @@ nlohmann::json NudgeJson(const NudgePlan& nudge);
 nlohmann::json FaultJson(const CellFault& fault);
 
 /// {"type": "safe_stop", round, reason ("fault", "stopped"), device, kind, state, error, held
-/// ("nothing", "tube", "unknown"), action ("stopped", "released_in_bin", "kept_closed"), p_Bin_tcp
-/// (where the TCP ended, or null), message}. After a fault: the fault's device, kind, state and
+/// ("nothing", "tube", "unknown"), action ("stopped", "released_in_bin", "kept_closed", "load_on_tool"),
+/// p_Bin_tcp (where the TCP ended, or null), message}. After a fault: the fault's device, kind, state and
 /// error; after an operator stop (result.operator_stop): device "operator", kind "stop", the state
 /// the stop came in and the operator's reason as error.
 nlohmann::json SafeStopRecord(std::uint32_t round, const CellRunResult& result, const std::string& state);

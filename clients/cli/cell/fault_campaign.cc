@@ -17,6 +17,7 @@ void FaultCampaign::Add(const SimRoundResult& round, const FaultInjector* inject
       ++safe_stops_holding;
       if (run.safe_stop->action == "released_in_bin") ++released_in_bin;
       if (run.safe_stop->action == "kept_closed") ++kept_closed;
+      if (run.safe_stop->action == "load_on_tool") ++load_on_tool;
     }
   }
   released_outside += round.tubes_elsewhere;
@@ -38,9 +39,11 @@ std::string FaultCampaign::KindsLine() const {
   for (const auto& [kind, count] : by_kind)
     kinds += fmt::format("{}{}={}", kinds.empty() ? "" : " ", kind, count);
   return fmt::format(
-      "faults by kind: {}; safe stops holding a tube: {} (released in the bin {}, kept closed {}); local "
-      "analyses: {}",
-      kinds.empty() ? "none" : kinds, safe_stops_holding, released_in_bin, kept_closed, local_analyses);
+      "faults by kind: {}; safe stops holding a tube: {} (released in the bin {}, kept closed {}, load still "
+      "on "
+      "the tool {}); local analyses: {}",
+      kinds.empty() ? "none" : kinds, safe_stops_holding, released_in_bin, kept_closed, load_on_tool,
+      local_analyses);
 }
 
 nlohmann::json FaultCampaign::Json(double rate, std::uint64_t seed) const {
@@ -53,6 +56,7 @@ nlohmann::json FaultCampaign::Json(double rate, std::uint64_t seed) const {
           {"safe_stops_holding", safe_stops_holding},
           {"released_in_bin", released_in_bin},
           {"kept_closed", kept_closed},
+          {"load_on_tool", load_on_tool},
           {"released_outside", released_outside},
           {"carried_out_unnoticed", carried_out_unnoticed},
           {"lost_in_transit", lost_in_transit},

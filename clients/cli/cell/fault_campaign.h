@@ -21,6 +21,8 @@ struct FaultCampaign {
   std::uint32_t safe_stops_holding = 0;
   std::uint32_t released_in_bin = 0;
   std::uint32_t kept_closed = 0;
+  /// Opened over the bin, but what was caught on the tool still hung there (the arm stayed in the bin).
+  std::uint32_t load_on_tool = 0;
   /// Tubes at rest anywhere but the bin, the place zone or the gripper (the world's truth).
   std::uint32_t released_outside = 0;
   /// Tubes that reached the place zone beyond the picks (SimRoundResult::tubes_unnoticed).
