@@ -13,7 +13,6 @@
 #include "clients/cell/cell_frame_check.h"
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
-#include "core/params.h"
 #include "core/wrench/resolution_hold.h"
 #include "wire/proto_convert.h"
 
@@ -377,34 +376,37 @@ void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen
 
 void CellController::CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
                                     const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt) {
-  // The same orientation and opening as the reference: whatever the tilt (a nudge leans the tool),
-  // a caught tube adds its weight to the force; more than F_tol of Algorithm 3 is not noise.
-  const WrenchParams wrench = ProfileParams(params_.profile.empty() ? "fast" : params_.profile).wrench;
-  const double tolerance = wrench.force_tolerance;
-  auto extra_load = [&](const std::string& name) {
+  auto load_now = [&](const std::string& name) {
     const devices::WrenchReading reading = ReadWrench();
     attempt.record["wrench"][name] = WrenchJson(reading);
-    return (reading.force - reference.force).norm();
+    return LoadOnTool(reference, reading);
   };
-  double load = extra_load(key);
-  if (load <= tolerance) return;
+  std::optional<double> load = load_now(key);
+  if (!load) return;
   spdlog::warn("cell: round {}: {:.2f} N on the tool after it let go ({}): lowering it into the bin once",
-               round_, load, key);
+               round_, *load, key);
   const Eigen::Isometry3d X_BinTcpUp = CurrentPose();
   MoveTo(X_BinTcpShed, params_.approach_speed, &attempt);
   MoveTo(X_BinTcpUp, params_.approach_speed, &attempt);
-  load = extra_load(key + "_again");
-  if (load <= tolerance) return;
+  load = load_now(key + "_again");
+  if (!load) return;
   held_ = Held::kUnknown;
   caught_reference_ = reference;
-  const double tube_weight = cell_.tube.mass * wrench.gravity;
+  const double tube_weight = cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
   const Eigen::Vector3d p = X_BinTcpUp.translation();
   throw CellFault(
       "ft_sensor", FaultKind::kUnexpectedLoad, ToString(state_),
       fmt::format("the tool carries {:.2f} N ({:.1f} times a tube's weight) after letting go, at "
                   "X_BinTcp ({:.3f}, {:.3f}, {:.3f}) m, also after lowering it into the bin once: a "
                   "tube caught on the pads or the housing?",
-                  load, load / tube_weight, p.x(), p.y(), p.z()));
+                  *load, *load / tube_weight, p.x(), p.y(), p.z()));
+}
+
+std::optional<double> CellController::LoadOnTool(const devices::WrenchReading& reference,
+                                                 const devices::WrenchReading& now) const {
+  const double load = (now.force - reference.force).norm();
+  if (load <= ProfileWrenchParams(params_.profile).force_tolerance) return std::nullopt;
+  return load;
 }
 
 void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {

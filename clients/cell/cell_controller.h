@@ -395,6 +395,11 @@ class CellController {
   /// bin and held_ unknown, so the safe stop lowers it over the bin's middle and opens there.
   void CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
                       const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt);
+  /// The force `now` adds to `reference` (the same opening and orientation: whatever the tilt, a
+  /// caught tube adds its weight), newtons, when it is more than F_tol of Algorithm 3 (not noise);
+  /// nullopt otherwise.
+  std::optional<double> LoadOnTool(const devices::WrenchReading& reference,
+                                   const devices::WrenchReading& now) const;
   /// The nudge skill's motions (kNudge), from home back to home.
   void ExecuteNudge(const NudgePlan& plan, Attempt& attempt);
   void GoHome(Attempt* attempt);

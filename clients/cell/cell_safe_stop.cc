@@ -10,7 +10,6 @@
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
-#include "core/params.h"
 
 namespace tubepick::cell {
 namespace {
@@ -76,12 +75,10 @@ void CellController::SafeStop(const StopCause& cause, CellRunResult& result) {
 std::optional<std::string> CellController::LoadStillCaught() {
   if (!caught_reference_) return std::nullopt;
   try {
-    const devices::WrenchReading now = devices_.ft_sensor->Read(params_.ft_timeout);
-    const double load = (now.force - caught_reference_->force).norm();
-    const double tolerance =
-        ProfileParams(params_.profile.empty() ? "fast" : params_.profile).wrench.force_tolerance;
-    if (load <= tolerance) return std::nullopt;
-    return fmt::format("{:.2f} N still hang on the tool", load);
+    const std::optional<double> load =
+        LoadOnTool(*caught_reference_, devices_.ft_sensor->Read(params_.ft_timeout));
+    if (!load) return std::nullopt;
+    return fmt::format("{:.2f} N still hang on the tool", *load);
   } catch (const std::exception& e) {
     return fmt::format("the F/T sensor did not answer ({}), so what was caught may still hang on the tool",
                        e.what());

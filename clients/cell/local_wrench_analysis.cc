@@ -7,6 +7,10 @@
 
 namespace tubepick::cell {
 
+WrenchParams ProfileWrenchParams(const std::string& profile) {
+  return ProfileParams(profile.empty() ? "fast" : profile).wrench;
+}
+
 v1::AnalyzeWrenchResponse LocalAnalyzeWrench(const v1::AnalyzeWrenchRequest& request,
                                              const std::string& profile) {
   WrenchJob job;
@@ -16,7 +20,7 @@ v1::AnalyzeWrenchResponse LocalAnalyzeWrench(const v1::AnalyzeWrenchRequest& req
   job.current.torque = FromProto(request.current().torque(), "current.torque");
   job.tube_mass = request.tube_mass();
   job.X_BinTcp = FromProto(request.tcp_pose(), "tcp_pose");
-  WrenchParams params = ProfileParams(profile.empty() ? "fast" : profile).wrench;
+  WrenchParams params = ProfileWrenchParams(profile);
   if (request.variant() != v1::RESOLUTION_VARIANT_UNSPECIFIED) {
     const std::optional<ResolutionVariant> variant = FromProto(request.variant());
     if (!variant) throw InvalidArgument("variant: unknown ResolutionVariant value");

@@ -2,9 +2,14 @@
 
 #include <string>
 
+#include "core/wrench/wrench_params.h"
 #include "tubepick/v1/wrench.pb.h"
 
 namespace tubepick::cell {
+
+/// The wrench parameters of `profile` ("" = "fast", the server's default profile), as the
+/// planner's AnalyzeWrench uses them.
+WrenchParams ProfileWrenchParams(const std::string& profile);
 
 /// AnalyzeWrench run in the controller's process, for when the planner cannot be reached while a
 /// tube is held: the server's analysis (wire/wrench_analysis.h) with the wrench parameters of

@@ -528,7 +528,6 @@ TEST_F(CellControllerTest, ATubeCaughtOnTheToolAfterANudgeIsNotCarriedHome) {
   EXPECT_EQ(result.fault->state(), "nudge");
   EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("carries 0.60 N (1.1 times a tube's weight)"));
   EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("caught on the pads or the housing"));
-  // Not carried home: the safe stop lowered it over the bin's middle and opened there.
   // Not carried home: the safe stop lowered it over the bin's middle and opened there; the load
   // still hangs on the tool (the last reading again), so the arm stays there, inside the bin.
   ASSERT_TRUE(result.safe_stop);

@@ -39,9 +39,8 @@ std::string FaultCampaign::KindsLine() const {
   for (const auto& [kind, count] : by_kind)
     kinds += fmt::format("{}{}={}", kinds.empty() ? "" : " ", kind, count);
   return fmt::format(
-      "faults by kind: {}; safe stops holding a tube: {} (released in the bin {}, kept closed {}, load still "
-      "on "
-      "the tool {}); local analyses: {}",
+      "faults by kind: {}; safe stops holding a tube: {} (released in the bin {}, kept closed {}, "
+      "load still on the tool {}); local analyses: {}",
       kinds.empty() ? "none" : kinds, safe_stops_holding, released_in_bin, kept_closed, load_on_tool,
       local_analyses);
 }
