@@ -28,6 +28,9 @@ Robotiq2F85Params DriverParams(const RobotiqRtuServer& server) {
   Robotiq2F85Params params;
   params.device = server.device_path();
   params.poll_period = std::chrono::milliseconds(2);
+  // A real gripper answers within the driver's 200 ms; the virtual one is a thread on a pty that a
+  // loaded 2-core CI machine can keep waiting longer (one clean-clone run lost a write at 200 ms).
+  params.response_timeout = std::chrono::milliseconds(1000);
   return params;
 }
 
