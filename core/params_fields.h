@@ -123,6 +123,8 @@ void DescribeFields(Visit& v, JoiningParams& p) {
   v("max_angle", p.max_angle, "radians");
   v("angular_weight", p.angular_weight, "metres per radian");
   v("max_tube_length", p.max_tube_length);
+  v("max_length_share", p.max_length_share,
+    "with tube.length known, no tube longer than this share of it; 0 = off");
   v("radius_shortcut", p.radius_shortcut);
   v("visibility_check", p.visibility_check);
   v("visibility_pixel_angle", p.visibility_pixel_angle);

@@ -69,7 +69,8 @@ struct TubeConfig {
   /// Tube radius, metres.
   double radius = 0.0125;
   /// Expected curve length, metres (a branched tube: all its branches together); 0 = unknown.
-  /// Branched tubes: junction joining completes no tree past it (JunctionCompletionParams).
+  /// Joining builds no tube or tree longer than a share of it (modeling.joining and
+  /// modeling.junctions max_length_share, 1.04 in the fast profile).
   double length = 0.50;
   /// Mass of one tube, kg.
   double mass = 0.055;

@@ -25,7 +25,8 @@ void DescribeFields(Visit& v, SensorConfig& sensor) {
 template <typename Visit>
 void DescribeFields(Visit& v, TubeConfig& tube) {
   v("radius", tube.radius, "Tube radius, m.");
-  v("length", tube.length, "Curve length, m; 0 = unknown.");
+  v("length", tube.length,
+    "Curve length, m (joining builds no tube longer than 1.04 times it); 0 = unknown.");
   v("mass", tube.mass, "Mass of one tube, kg.");
   v.Enum(
       "topology", tube.topology, [](TubeTopology t) { return ToString(t); }, ParseTubeTopology,

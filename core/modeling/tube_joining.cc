@@ -70,6 +70,7 @@ void ValidateParams(const JoiningParams& p) {
   RequireInRange(p.max_angle, 0.0, 2.0 * kPi, "joining.max_angle");
   RequireNonNegative(p.angular_weight, "joining.angular_weight");
   RequireNonNegative(p.max_tube_length, "joining.max_tube_length");
+  RequireNonNegative(p.max_length_share, "joining.max_length_share");
   RequireNonNegative(p.radius_shortcut, "joining.radius_shortcut");
   RequirePositive(p.visibility_pixel_angle, "joining.visibility_pixel_angle");
   RequireNonNegative(p.visibility_min_gap, "joining.visibility_min_gap");
@@ -372,6 +373,12 @@ std::vector<Tube> BuildTubes(const std::vector<Cylinder>& cylinders, const Chain
 }
 
 }  // namespace
+
+double MaxJoinedLength(const JoiningParams& params, double tube_length) {
+  if (!(tube_length > 0.0) || !(params.max_length_share > 0.0)) return params.max_tube_length;
+  const double share = params.max_length_share * tube_length;
+  return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
+}
 
 JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a_out,
                               const Eigen::Vector3d& b, const Eigen::Vector3d& b_out, double shortcut_radius,

@@ -29,6 +29,9 @@ struct JoiningParams {
   double angular_weight = 0.001 * 180.0 / 3.14159265358979323846;
   /// Length constraint: joined tubes may not exceed this, metres; 0 disables it.
   double max_tube_length = 0.60;
+  /// With the cell's tube length known, joined tubes may not exceed this share of it either
+  /// (MaxJoinedLength); 0 = only max_tube_length (the thesis).
+  double max_length_share = 0.0;
   /// Euclidean distance below which the angular distance counts as 0 (the radius shortcut);
   /// 0 = use the mean radius of the two cylinders, as the thesis.
   double radius_shortcut = 0.0;
@@ -43,6 +46,10 @@ struct JoiningParams {
   double visibility_min_gap = 0.0;
   JoiningStrategy strategy = JoiningStrategy::kGreedy;
 };
+
+/// The longest tube joining may build, metres (0 = no limit): max_tube_length, and with
+/// `tube_length` > 0 and max_length_share > 0, at most max_length_share · tube_length.
+double MaxJoinedLength(const JoiningParams& params, double tube_length);
 
 /// Endpoint-pair distance terms, exposed for tests.
 struct JoinDistance {

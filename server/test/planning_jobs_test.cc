@@ -48,10 +48,11 @@ const std::string& ThreeTubesCloud() {
 }
 
 // Three inclined tubes woven into a triangle: each lies on the next one at its start and under the
-// previous one at its end, so every tube is weakly occluded and planning must simulate.
+// previous one at its end, so every tube is weakly occluded and planning must simulate. Each tube
+// is 0.50 m long, the default cell's tube.length (joining builds no longer tube).
 const std::string& WeaveCloud() {
   static const std::string bytes = [] {
-    const double side = 0.30, extension = 0.12;
+    const double side = 0.30, extension = 0.10;
     const double drop = 2.0 * kR;  // height change between the two crossings of a tube
     const double slope = drop / side;
     std::vector<Eigen::Vector2d> v;

@@ -128,6 +128,29 @@ TEST(ModelTubes, LengthConstraintPreventsOverlongTube) {
   EXPECT_EQ(Model(cloud, 7, params).tubes.size(), 2u);
 }
 
+TEST(ModelTubes, TheCellsTubeLengthBoundsLinearJoining) {
+  // The 0.70 m tube of the test above under a crossing one: within max_tube_length (0.80), but
+  // a cell whose tubes are 0.5 m long cannot have it, so it stays two tubes there.
+  const SyntheticTube lower = FloorTube({{-0.35, 0.0}, {0.35, 0.0}});
+  const SyntheticTube upper = FloorTube({{0.0, -0.18}, {0.0, 0.18}}, kRadius, 2.0 * kRadius);
+  const Points cloud = Render({lower, upper});
+  ModelingParams params = FastModelingProfile();
+  params.joining.max_tube_length = 0.80;
+  ASSERT_DOUBLE_EQ(params.joining.max_length_share, 1.04);
+  ModelingInput input;
+  input.points_Sensor = &cloud;
+  input.seed = 7;
+  auto tubes_with_length = [&](double tube_length) {
+    input.tube_length = tube_length;
+    return ModelTubes(input, params).tubes.size();
+  };
+  EXPECT_EQ(tubes_with_length(0.0), 2u);   // unknown: max_tube_length alone
+  EXPECT_EQ(tubes_with_length(0.70), 2u);  // 0.728 m allowed
+  EXPECT_EQ(tubes_with_length(0.50), 3u);  // 0.52 m allowed
+  params.joining.max_length_share = 0.0;   // off
+  EXPECT_EQ(tubes_with_length(0.50), 2u);
+}
+
 TEST(ModelTubes, MillimetreInputEqualsMetreInput) {
   const Points metres = Render({FloorTube({{-0.15, -0.1}, {0.0, 0.0}, {0.15, 0.05}})});
   Points millimetres = metres;

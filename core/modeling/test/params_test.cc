@@ -32,12 +32,21 @@ TEST(Params, ThesisProfileHasTableValues) {
   EXPECT_DOUBLE_EQ(p.cylinders.safety_radius, 0.02);
   EXPECT_DOUBLE_EQ(p.cylinders.distance_threshold, 0.02);
   EXPECT_DOUBLE_EQ(p.joining.max_tube_length, 0.60);
+  EXPECT_DOUBLE_EQ(p.joining.max_distance, 0.10);                      // Table 4.3
+  EXPECT_DOUBLE_EQ(p.joining.max_length_share, 0.0);                   // the thesis knows no tube length
   EXPECT_NEAR(p.joining.angular_weight * M_PI / 180.0, 0.001, 1e-12);  // 0.001 m per degree
   EXPECT_EQ(p.normals.search_surface, SearchSurface::kRaw);
   ASSERT_EQ(p.filters.size(), 7u);
   EXPECT_EQ(std::get<RandomSampleParams>(p.filters[1]).count, 100000u);
   EXPECT_EQ(std::get<RandomSampleParams>(p.filters[4]).count, 25000u);
   EXPECT_EQ(std::get<StatisticalOutlierParams>(p.filters[6]).neighbours, 100u);
+}
+
+TEST(Params, TheFastProfileJoinsHiddenGapsUpTo18CentimetresWithinTheCellsTubeLength) {
+  const JoiningParams& j = ProfileParams("fast").modeling.joining;
+  EXPECT_DOUBLE_EQ(j.max_distance, 0.18);
+  EXPECT_DOUBLE_EQ(j.max_length_share, 1.04);
+  EXPECT_DOUBLE_EQ(j.max_tube_length, 0.60);
 }
 
 TEST(Params, TheResolutionRotatesTheThesis45DegreesOr55InTheFastProfile) {

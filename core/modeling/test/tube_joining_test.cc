@@ -250,6 +250,22 @@ TEST(JoinTubes, LengthConstraint) {
   }
 }
 
+TEST(JoinTubes, MaxJoinedLengthIsTheSmallerOfTheAbsoluteAndTheCellsShare) {
+  JoiningParams params;
+  params.max_tube_length = 0.6;
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.5), 0.6);  // share off (the thesis)
+  params.max_length_share = 1.04;
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.5), 0.52);
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.0), 0.6);  // tube length unknown
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.8), 0.6);  // the absolute limit still holds
+  params.max_tube_length = 0.0;
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.8), 0.8 * 1.04);
+  EXPECT_DOUBLE_EQ(MaxJoinedLength(params, 0.0), 0.0);  // no limit at all
+  params.max_length_share = -1.0;
+  EXPECT_THAT([&] { JoinTubes({}, params, nullptr); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("joining.max_length_share")));
+}
+
 TEST(JoinTubes, LengthConstraintAppliesToTheWholeChain) {
   // Three collinear 0.25 m cylinders with 1 cm gaps: any two fit 0.6 m, all three (0.77 m) do not.
   const std::vector<Cylinder> cylinders = {FloorCylinder(-0.385, 0.0, -0.135, 0.0, 0),
