@@ -236,11 +236,9 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
   }
   const RangeImage* seen = visibility ? &*visibility : nullptr;
-  // Linear tubes: no longer than the cell's tube length allows (max_length_share).
-  JoiningParams linear_joining = params.joining;
-  linear_joining.max_tube_length = MaxJoinedLength(params.joining, input.tube_length);
   if (input.topology == TubeTopology::kLinear) {
-    result.tubes = JoinTubes(cylinders, linear_joining, seen, stop);
+    result.tubes = JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop,
+                                     &result.tube_length_disagrees);
   } else {
     // 6. Junctions. Chains are joined within stricter limits first (JunctionParams::
     // chain_max_distance), then into trees; `auto` keeps the plain linear joining when the scene
@@ -262,7 +260,8 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     if (branched) {
       result.tubes = std::move(joined.tubes);
     } else {
-      result.tubes = JoinTubes(cylinders, linear_joining, seen, stop);
+      result.tubes = JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop,
+                                       &result.tube_length_disagrees);
     }
   }
   result.tube_of_point = TubeOfPoint(result.tubes, cylinders, inliers_of, cloud.size());

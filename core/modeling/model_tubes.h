@@ -33,8 +33,8 @@ struct ModelingInput {
   TubeTopology topology = TubeTopology::kLinear;
   /// The fitting at their junctions (CellConfig tube.junction_shape).
   JunctionShape junction_shape = JunctionShape::kAny;
-  /// The length of one tube (CellConfig tube.length), metres; 0 = unknown. Bounds the junction
-  /// joining's completion (JunctionCompletionParams).
+  /// The length of one tube (CellConfig tube.length), metres; 0 = unknown. Bounds joining
+  /// (JoinTubesOfLength, and the junction joining's trees and completion).
   double tube_length = 0.0;
 };
 
@@ -56,6 +56,9 @@ struct ModelingResult {
   std::uint64_t dropped_non_finite = 0;
   /// How the finite input fits the bin (points inside, floor seen, extent).
   CloudPlausibility plausibility;
+  /// The scene's whole tubes were longer than the cell's tube.length allows (JoinTubesOfLength):
+  /// joined within their length instead, and a warning logged.
+  bool tube_length_disagrees = false;
   std::uint32_t segment_count = 0;
   std::uint32_t cylinder_count = 0;
   std::vector<StepCount> counts;

@@ -45,6 +45,8 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "core/common/errors.h"
 #include "core/common/require.h"
 
@@ -380,6 +382,17 @@ double MaxJoinedLength(const JoiningParams& params, double tube_length) {
   return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
 }
 
+double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length) {
+  std::vector<double> lengths;
+  for (const Tube& tube : unbounded) {
+    if (tube.length() >= 0.8 * tube_length) lengths.push_back(tube.length());
+  }
+  if (lengths.empty()) return 0.0;
+  const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+  std::nth_element(lengths.begin(), middle, lengths.end());
+  return *middle;
+}
+
 JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a_out,
                               const Eigen::Vector3d& b, const Eigen::Vector3d& b_out, double shortcut_radius,
                               const JoiningParams& params) {
@@ -409,6 +422,28 @@ std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const Joinin
     JoinGreedy(candidates, &chains, stop);
   }
   return BuildTubes(cylinders, chains);
+}
+
+std::vector<Tube> JoinTubesOfLength(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
+                                    double tube_length, const RangeImage* visibility, const StopToken* stop,
+                                    bool* length_disagrees) {
+  if (length_disagrees != nullptr) *length_disagrees = false;
+  const double stated_bound = MaxJoinedLength(params, tube_length);
+  std::vector<Tube> unbounded = JoinTubes(cylinders, params, visibility, stop);
+  if (stated_bound == params.max_tube_length) return unbounded;  // no share, or the absolute limit is smaller
+  const double whole = WholeTubeLength(unbounded, tube_length);
+  if (whole > stated_bound) {
+    spdlog::warn(
+        "tube.length {:.3f} m: the tubes this scan shows about whole are {:.3f} m long (median), more than "
+        "{:.2f} times it; is tube.length the parts' whole curve length? Joined up to {:.2f} times {:.3f} m",
+        tube_length, whole, params.max_length_share, params.max_length_share, whole);
+    if (length_disagrees != nullptr) *length_disagrees = true;
+  }
+  const double bound = MaxJoinedLength(params, std::max(tube_length, whole));
+  if (bound == params.max_tube_length) return unbounded;
+  JoiningParams bounded = params;
+  bounded.max_tube_length = bound;
+  return JoinTubes(cylinders, bounded, visibility, stop);
 }
 
 }  // namespace tubepick

@@ -51,6 +51,12 @@ struct JoiningParams {
 /// `tube_length` > 0 and max_length_share > 0, at most max_length_share · tube_length.
 double MaxJoinedLength(const JoiningParams& params, double tube_length);
 
+/// The length of a scene's whole tubes: the median length of the `unbounded` tubes (joined
+/// without the share bound) at least 0.8 · tube_length long, the tubes seen about whole; 0 when
+/// there is none. With the cell's tube.length right it is about that length (a merge is rarely
+/// the median); a cell that states its tubes shorter than they are shows it here.
+double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length);
+
 /// Endpoint-pair distance terms, exposed for tests.
 struct JoinDistance {
   double euclidean = 0.0;
@@ -78,5 +84,14 @@ JoinDistance EndpointDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& a
 /// @throws Cancelled when `stop` fires.
 std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
                             const RangeImage* visibility, const StopToken* stop = nullptr);
+
+/// JoinTubes for a cell whose tubes are `tube_length` long (0 = unknown): no tube longer than
+/// MaxJoinedLength of the longer of tube_length and the scene's WholeTubeLength. When the scene's
+/// whole tubes are longer than that bound of tube_length alone, a warning names tube.length and
+/// what the scan shows, and `length_disagrees` (optional) is set: the cell's tube.length is
+/// probably shorter than its parts.
+std::vector<Tube> JoinTubesOfLength(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
+                                    double tube_length, const RangeImage* visibility, const StopToken* stop,
+                                    bool* length_disagrees = nullptr);
 
 }  // namespace tubepick

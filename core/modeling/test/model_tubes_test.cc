@@ -128,27 +128,48 @@ TEST(ModelTubes, LengthConstraintPreventsOverlongTube) {
   EXPECT_EQ(Model(cloud, 7, params).tubes.size(), 2u);
 }
 
+// Two free 0.40 m tubes and a 0.70 m one under a crossing tube: within max_tube_length (0.80).
+Points WholeTubesAndALongOne() {
+  return Render({FloorTube({{-0.20, -0.25}, {0.20, -0.25}}), FloorTube({{-0.20, 0.25}, {0.20, 0.25}}),
+                 FloorTube({{-0.35, 0.0}, {0.35, 0.0}}),
+                 FloorTube({{0.0, -0.18}, {0.0, 0.18}}, kRadius, 2.0 * kRadius)});
+}
+
 TEST(ModelTubes, TheCellsTubeLengthBoundsLinearJoining) {
-  // The 0.70 m tube of the test above under a crossing one: within max_tube_length (0.80), but
-  // a cell whose tubes are 0.5 m long cannot have it, so it stays two tubes there.
-  const SyntheticTube lower = FloorTube({{-0.35, 0.0}, {0.35, 0.0}});
-  const SyntheticTube upper = FloorTube({{0.0, -0.18}, {0.0, 0.18}}, kRadius, 2.0 * kRadius);
-  const Points cloud = Render({lower, upper});
+  const Points cloud = WholeTubesAndALongOne();
   ModelingParams params = FastModelingProfile();
   params.joining.max_tube_length = 0.80;
   ASSERT_DOUBLE_EQ(params.joining.max_length_share, 1.04);
   ModelingInput input;
   input.points_Sensor = &cloud;
   input.seed = 7;
-  auto tubes_with_length = [&](double tube_length) {
+  auto model = [&](double tube_length) {
     input.tube_length = tube_length;
-    return ModelTubes(input, params).tubes.size();
+    return ModelTubes(input, params);
   };
-  EXPECT_EQ(tubes_with_length(0.0), 2u);   // unknown: max_tube_length alone
-  EXPECT_EQ(tubes_with_length(0.70), 2u);  // 0.728 m allowed
-  EXPECT_EQ(tubes_with_length(0.50), 3u);  // 0.52 m allowed
-  params.joining.max_length_share = 0.0;   // off
-  EXPECT_EQ(tubes_with_length(0.50), 2u);
+  EXPECT_EQ(model(0.0).tubes.size(), 4u);  // unknown: max_tube_length alone
+  // A cell of 0.40 m tubes cannot have a 0.70 m one: two pieces (the whole tubes the scan shows
+  // are 0.40 m, the median of 0.36, 0.40, 0.40 and 0.70).
+  const ModelingResult bounded = model(0.40);
+  EXPECT_EQ(bounded.tubes.size(), 5u);
+  EXPECT_FALSE(bounded.tube_length_disagrees);
+  params.joining.max_length_share = 0.0;  // off
+  EXPECT_EQ(model(0.40).tubes.size(), 4u);
+}
+
+TEST(ModelTubes, ATubeLengthShorterThanTheScanShowsIsNotBelieved) {
+  // The same scene in a cell that says its tubes are 0.30 m: every tube seen whole is longer
+  // (median 0.40 m), so joining bounds them by that and flags the disagreement.
+  const Points cloud = WholeTubesAndALongOne();
+  ModelingParams params = FastModelingProfile();
+  params.joining.max_tube_length = 0.80;
+  ModelingInput input;
+  input.points_Sensor = &cloud;
+  input.seed = 7;
+  input.tube_length = 0.30;
+  const ModelingResult r = ModelTubes(input, params);
+  EXPECT_TRUE(r.tube_length_disagrees);
+  EXPECT_EQ(r.tubes.size(), 5u);
 }
 
 TEST(ModelTubes, MillimetreInputEqualsMetreInput) {

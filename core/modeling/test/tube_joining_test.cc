@@ -266,6 +266,45 @@ TEST(JoinTubes, MaxJoinedLengthIsTheSmallerOfTheAbsoluteAndTheCellsShare) {
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("joining.max_length_share")));
 }
 
+// Two whole 0.50 m tubes and two collinear pieces, 0.30 and 0.29 m with a 1 cm gap: one tube of
+// 0.60 m if joined, within max_tube_length (0.8 here).
+std::vector<Cylinder> TwoWholeTubesAndTwoPieces() {
+  return {FloorCylinder(-0.25, -0.2, 0.25, -0.2, 0), FloorCylinder(-0.25, 0.2, 0.25, 0.2, 1),
+          FloorCylinder(-0.30, 0.0, 0.0, 0.0, 2), FloorCylinder(0.01, 0.0, 0.30, 0.0, 3)};
+}
+
+TEST(JoinTubesOfLength, NoTubeLongerThanTheShareOfTheCellsTubeLength) {
+  JoiningParams params = NoVisibility(JoiningStrategy::kGlobal);
+  params.max_tube_length = 0.8;
+  params.max_length_share = 1.04;
+  const std::vector<Cylinder> cylinders = TwoWholeTubesAndTwoPieces();
+  bool disagrees = true;
+  // Joined without the share: the whole tubes are 0.50 m (median of 0.50, 0.50, 0.60).
+  EXPECT_NEAR(WholeTubeLength(JoinTubes(cylinders, params, nullptr), 0.5), 0.5, kTol);
+  EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.5, nullptr, nullptr, &disagrees).size(), 4u);  // ≤ 0.52 m
+  EXPECT_FALSE(disagrees);
+  EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.0, nullptr, nullptr, &disagrees).size(), 3u);  // unknown
+  EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.6, nullptr, nullptr, &disagrees).size(), 3u);  // ≤ 0.624 m
+  params.max_length_share = 0.0;
+  EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.5, nullptr, nullptr, &disagrees).size(), 3u);
+}
+
+TEST(JoinTubesOfLength, ACellThatStatesItsTubesShorterThanTheScanShowsThemIsToldAndNotBelieved) {
+  JoiningParams params = NoVisibility(JoiningStrategy::kGlobal);
+  params.max_tube_length = 0.8;
+  params.max_length_share = 1.04;
+  // The same pieces with their tubes 0.60 m long, in a cell that says 0.45 m: the whole tubes the
+  // scan shows are 0.60 m, so joining bounds them by 1.04 · 0.60 m and says so.
+  std::vector<Cylinder> cylinders = TwoWholeTubesAndTwoPieces();
+  cylinders[0] = FloorCylinder(-0.30, -0.2, 0.30, -0.2, 0);
+  cylinders[1] = FloorCylinder(-0.30, 0.2, 0.30, 0.2, 1);
+  bool disagrees = false;
+  const std::vector<Tube> tubes = JoinTubesOfLength(cylinders, params, 0.45, nullptr, nullptr, &disagrees);
+  EXPECT_TRUE(disagrees);
+  ASSERT_EQ(tubes.size(), 3u);
+  for (const Tube& tube : tubes) EXPECT_NEAR(tube.length(), 0.6, 0.011);
+}
+
 TEST(JoinTubes, LengthConstraintAppliesToTheWholeChain) {
   // Three collinear 0.25 m cylinders with 1 cm gaps: any two fit 0.6 m, all three (0.77 m) do not.
   const std::vector<Cylinder> cylinders = {FloorCylinder(-0.385, 0.0, -0.135, 0.0, 0),
