@@ -34,6 +34,8 @@
 #include <optional>
 #include <tuple>
 
+#include <spdlog/spdlog.h>
+
 #include "core/common/errors.h"
 #include "core/common/require.h"
 #include "core/common/segment_geometry.h"
@@ -656,9 +658,12 @@ std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const Junct
   return out;
 }
 
-JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
-                              JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                              double tube_length) {
+namespace {
+
+// JoinJunctions with its trees bounded by `max_tree_length` (0 = no limit).
+JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const JunctionParams& params,
+                                    JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
+                                    double tube_length, double max_tree_length) {
   params.Validate();
   ThrowIfStopped(stop, "joining");
   CompletionCandidates completion;
@@ -671,10 +676,9 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
     completion.sides = FindJunctions(chains, wide, shape, rooms);
     completion.pairs = FindEndMeetings(chains, wide, rooms);
   }
-  const Accepted accepted =
-      Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
-             FindJunctions(chains, params, shape, rooms), completion, MaxTreeLength(params, tube_length),
-             max_completed_length, params, shape, stop);
+  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+                                   FindJunctions(chains, params, shape, rooms), completion, max_tree_length,
+                                   max_completed_length, params, shape, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
@@ -716,6 +720,37 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
   out.tube_of_chain.resize(chains.size());
   for (std::size_t c = 0; c < chains.size(); ++c) out.tube_of_chain[c] = rank[built_from[c]];
   return out;
+}
+
+}  // namespace
+
+JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
+                              JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
+                              double tube_length) {
+  return JoinJunctionsWithin(chains, params, shape, stop, rooms, tube_length,
+                             MaxTreeLength(params, tube_length));
+}
+
+JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const JunctionParams& params,
+                                      JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
+                                      double tube_length, bool* length_disagrees) {
+  if (length_disagrees != nullptr) *length_disagrees = false;
+  if (!(tube_length > 0.0)) return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
+  // The trees within max_tube_length alone: how long are the ones seen about whole? Four of them
+  // at least: in a bin of two or three trees one merge can be the median (a 3-tree bin of set C).
+  constexpr std::size_t kMinWholeTrees = 4;
+  const double whole = WholeTubeLength(
+      JoinJunctionsWithin(chains, params, shape, stop, rooms, tube_length, params.max_tube_length).tubes,
+      tube_length, kMinWholeTrees);
+  if (whole <= MaxTreeLength(params, tube_length)) {
+    return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
+  }
+  spdlog::warn(
+      "tube.length {:.3f} m: the branched tubes this scan shows about whole are {:.3f} m long (median), more "
+      "than {:.2f} times it; is tube.length all branches of a part together? Joined as if it were {:.3f} m",
+      tube_length, whole, params.max_length_share, whole);
+  if (length_disagrees != nullptr) *length_disagrees = true;
+  return JoinJunctions(chains, params, shape, stop, rooms, whole);
 }
 
 bool LooksBranched(const JunctionJoining& joined, const JunctionParams& params) {

@@ -249,8 +249,8 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
     const EndRooms rooms =
         MeasureEndRooms(UnfittedPoints(cloud.points, inliers_of), chains, params.junctions.end_room, seen);
-    JunctionJoining joined =
-        JoinJunctions(chains, params.junctions, input.junction_shape, stop, rooms, input.tube_length);
+    JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop,
+                                                   rooms, input.tube_length, &result.tube_length_disagrees);
     const bool branched =
         input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
     spdlog::debug(

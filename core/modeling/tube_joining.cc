@@ -382,12 +382,12 @@ double MaxJoinedLength(const JoiningParams& params, double tube_length) {
   return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
 }
 
-double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length) {
+double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length, std::size_t min_whole) {
   std::vector<double> lengths;
   for (const Tube& tube : unbounded) {
     if (tube.length() >= 0.8 * tube_length) lengths.push_back(tube.length());
   }
-  if (lengths.empty()) return 0.0;
+  if (lengths.empty() || lengths.size() < min_whole) return 0.0;
   const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
   std::nth_element(lengths.begin(), middle, lengths.end());
   return *middle;

@@ -54,8 +54,9 @@ double MaxJoinedLength(const JoiningParams& params, double tube_length);
 /// The length of a scene's whole tubes: the median length of the `unbounded` tubes (joined
 /// without the share bound) at least 0.8 · tube_length long, the tubes seen about whole; 0 when
 /// there is none. With the cell's tube.length right it is about that length (a merge is rarely
-/// the median); a cell that states its tubes shorter than they are shows it here.
-double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length);
+/// the median); a cell that states its tubes shorter than they are shows it here. 0 also when
+/// fewer than `min_whole` tubes are that long.
+double WholeTubeLength(const std::vector<Tube>& unbounded, double tube_length, std::size_t min_whole = 1);
 
 /// Endpoint-pair distance terms, exposed for tests.
 struct JoinDistance {

@@ -145,6 +145,41 @@ TEST(JunctionJoining, TheCellsTubeLengthBoundsEveryTree) {
               ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("modeling.junctions.max_length_share")));
 }
 
+// `count` Y-pieces of 0.575 m (with their links) side by side, 0.4 m apart.
+std::vector<Tube> YPieces(int count) {
+  std::vector<Tube> chains;
+  for (int i = 0; i < count; ++i) {
+    for (Tube& arm : YPiece({-0.6 + 0.4 * i, 0, kR}, 0.025, 3 * static_cast<std::uint32_t>(i))) {
+      chains.push_back(std::move(arm));
+    }
+  }
+  return chains;
+}
+
+TEST(JunctionJoining, ATubeLengthShorterThanFourWholeTreesShowIsNotBelieved) {
+  const JunctionParams params;
+  bool disagrees = true;
+  // The cell's length right: four trees, as JoinJunctions makes them.
+  EXPECT_EQ(JoinJunctionsOfLength(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.575, &disagrees)
+                .tubes.size(),
+            4u);
+  EXPECT_FALSE(disagrees);
+  // Said to be 0.50 m: bound by it, every Y would be refused (0.575 > 0.52 m). The four trees the
+  // scan shows whole are 0.575 m (median), so they are joined as that long, and it is said.
+  ASSERT_GT(JoinJunctions(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.50).tubes.size(), 4u);
+  EXPECT_EQ(JoinJunctionsOfLength(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.50, &disagrees)
+                .tubes.size(),
+            4u);
+  EXPECT_TRUE(disagrees);
+  // Three trees are too few to overrule the cell (in a bin of three, one merge can be the median).
+  const JunctionJoining three =
+      JoinJunctionsOfLength(YPieces(3), params, JunctionShape::kAny, nullptr, {}, 0.50, &disagrees);
+  EXPECT_FALSE(disagrees);
+  EXPECT_EQ(three.tubes.size(),
+            JoinJunctions(YPieces(3), params, JunctionShape::kAny, nullptr, {}, 0.50).tubes.size());
+  EXPECT_GT(three.tubes.size(), 3u);
+}
+
 TEST(JunctionJoining, TheRoomPastAnEndSetsItsReach) {
   // A run along x; a branch along y whose cylinder ends 8 cm from the run's axis (region growing
   // left its last centimetres unfitted): beyond the T-piece reach (radius + side_max_gap).
