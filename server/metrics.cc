@@ -74,6 +74,19 @@ void Metrics::RecordExpiredInQueue() {
   ++expired_in_queue_;
 }
 
+void Metrics::RecordModelingWarning(std::string_view code) {
+  std::lock_guard lock(mu_);
+  auto it = modeling_warnings_.find(code);
+  if (it == modeling_warnings_.end()) it = modeling_warnings_.emplace(std::string(code), 0).first;
+  ++it->second;
+}
+
+std::uint64_t Metrics::modeling_warnings(std::string_view code) const {
+  std::lock_guard lock(mu_);
+  auto it = modeling_warnings_.find(code);
+  return it == modeling_warnings_.end() ? 0 : it->second;
+}
+
 std::uint64_t Metrics::calls(std::string_view method, std::string_view code) const {
   std::lock_guard lock(mu_);
   auto it = calls_.find(std::pair<std::string, std::string>(method, code));
@@ -116,6 +129,10 @@ std::string Metrics::RenderPrometheus(const PoolLoad& load, std::uint32_t upload
     header("tubepick_queue_expired_total", "counter",
            "Requests cancelled or past their deadline while queued; dropped without running.");
     fmt::format_to(o, "tubepick_queue_expired_total {}\n", expired_in_queue_);
+    header("tubepick_modeling_warnings_total", "counter",
+           "Answers whose modeling warned that a cell input probably does not fit the scene, by code.");
+    for (const auto& [code, count] : modeling_warnings_)
+      fmt::format_to(o, "tubepick_modeling_warnings_total{{code=\"{}\"}} {}\n", code, count);
   }
   header("tubepick_queue_depth", "gauge", "Admitted requests waiting for a planning worker.");
   fmt::format_to(o, "tubepick_queue_depth {}\n", load.queued);

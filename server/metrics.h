@@ -41,9 +41,12 @@ class Metrics {
   /// A request whose deadline passed (or that was cancelled) while it waited in the queue, so it
   /// never ran.
   void RecordExpiredInQueue();
+  /// An answer that carried a modeling warning with this code (ModelingWarning.code).
+  void RecordModelingWarning(std::string_view code);
 
   std::uint64_t calls(std::string_view method, std::string_view code) const;
   std::uint64_t rejected() const;
+  std::uint64_t modeling_warnings(std::string_view code) const;
 
   /// Every metric with HELP and TYPE lines; `load` gives the queue and worker gauges, `uploads`
   /// the PlanPickStream uploads in progress.
@@ -60,6 +63,7 @@ class Metrics {
   std::map<std::string, Histogram, std::less<>> durations_;
   std::uint64_t rejected_ = 0;
   std::uint64_t expired_in_queue_ = 0;
+  std::map<std::string, std::uint64_t, std::less<>> modeling_warnings_;
 };
 
 }  // namespace tubepick::server

@@ -27,6 +27,13 @@ Clock::duration Seconds(double seconds) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
+// The codes of a modeling's warnings, for the call's log line and metrics.
+std::vector<std::string> WarningCodes(const v1::ModelTubesResponse& modeling) {
+  std::vector<std::string> codes;
+  for (const v1::ModelingWarning& w : modeling.warnings()) codes.push_back(w.code());
+  return codes;
+}
+
 // A caller mistake's status: RESOURCE_EXHAUSTED for one over a size limit (TooLarge, the code gRPC
 // gives a message over max_message_bytes), INVALID_ARGUMENT for the rest. Every path maps it here.
 grpc::Status CallerMistake(const InvalidArgument& e) {
@@ -274,6 +281,7 @@ class PlannerService::StreamCall final : public grpc::ServerReadReactor<v1::Plan
         std::string().swap(cloud_);  // modeling read the bytes in place
         state_.record.tubes = static_cast<std::uint32_t>(response_->response().tubes_size());
         state_.record.plans = static_cast<std::uint32_t>(response_->response().plans_size());
+        state_.record.warnings = WarningCodes(response_->response().modeling());
       });
       Answer(status);
     });
@@ -369,7 +377,9 @@ grpc::Status PlannerService::Conclude(CallState& call, grpc::Status status) {
     r.tubes = 0;
     r.plans = 0;
   }
+  if (!status.ok()) r.warnings.clear();
   metrics_->RecordCall(r.rpc, r.code, r.total_ms / 1000.0);
+  for (const std::string& code : r.warnings) metrics_->RecordModelingWarning(code);
   LogCall(r);
   if (debug_calls_ != nullptr && r.rpc != "AnalyzeWrench") debug_calls_->Add(r, std::move(call.debug));
   served_.fetch_add(1);
@@ -446,6 +456,7 @@ grpc::ServerUnaryReactor* PlannerService::ModelTubes(grpc::CallbackServerContext
                          *response = RunModelTubes(job, threads_per_call_, &call.token);
                          if (call.debug) call.debug->frame.modeling = *response;
                          call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
+                         call.record.warnings = WarningCodes(*response);
                        });
 }
 
@@ -460,6 +471,7 @@ grpc::ServerUnaryReactor* PlannerService::PlanPick(grpc::CallbackServerContext* 
                          if (call.debug) call.debug->frame.plan = *response;
                          call.record.tubes = static_cast<std::uint32_t>(response->tubes_size());
                          call.record.plans = static_cast<std::uint32_t>(response->plans_size());
+                         call.record.warnings = WarningCodes(response->modeling());
                        });
 }
 

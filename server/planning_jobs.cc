@@ -19,15 +19,10 @@ namespace {
 ModelingResult Model(const PlanningJob& job, const RawRegion& raw_region_Bin, std::uint32_t threads,
                      const StopToken* stop) {
   ThrowIfStopped(stop, "request admission");
-  ModelingInput input;
+  ModelingInput input = ModelingInputFor(job.cell);
   input.xyz_Sensor = PackedXyz{job.xyz_Sensor};
   input.raw_region_Bin = raw_region_Bin;
   input.unit = job.unit;
-  input.X_BinSensor = job.cell.sensor.X_BinSensor;
-  input.bin = job.cell.bin;
-  input.topology = job.cell.tube.topology;
-  input.junction_shape = job.cell.tube.junction_shape;
-  input.tube_length = job.cell.tube.length;
   input.seed = job.seed;
   ModelingParams params = job.params.modeling;
   params.threads = threads;

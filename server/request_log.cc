@@ -2,6 +2,7 @@
 
 #include <fmt/chrono.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/details/log_msg.h>
 #include <spdlog/spdlog.h>
 
@@ -66,6 +67,7 @@ std::string FormatCallText(const CallRecord& r) {
       r.rpc, r.request_id, r.peer, r.code, r.points, r.tubes, r.plans, Ms(r.queue_ms), Ms(r.run_ms),
       Ms(r.total_ms));
   if (r.stop_ms) out += fmt::format(" stop_ms={}", Ms(*r.stop_ms));
+  if (!r.warnings.empty()) out += fmt::format(" warnings={}", fmt::join(r.warnings, ","));
   if (!r.message.empty()) out += fmt::format(" message=\"{}\"", JsonEscape(r.message));
   return out;
 }
@@ -77,6 +79,12 @@ std::string FormatCallJson(const CallRecord& r) {
       JsonEscape(r.rpc), JsonEscape(r.request_id), JsonEscape(r.peer), JsonEscape(r.code), r.points, r.tubes,
       r.plans, Ms(r.queue_ms), Ms(r.run_ms), Ms(r.total_ms));
   if (r.stop_ms) out += fmt::format(R"(,"stop_ms":{})", Ms(*r.stop_ms));
+  if (!r.warnings.empty()) {
+    out += R"(,"warnings":[)";
+    for (std::size_t i = 0; i < r.warnings.size(); ++i)
+      out += fmt::format(R"({}"{}")", i == 0 ? "" : ",", JsonEscape(r.warnings[i]));
+    out += ']';
+  }
   if (!r.message.empty()) out += fmt::format(R"(,"message":"{}")", JsonEscape(r.message));
   out += '}';
   return out;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <spdlog/formatter.h>
 
@@ -31,10 +32,13 @@ struct CallRecord {
   /// Cancelled or expired calls: from the stop request (cancel or deadline) until the worker was
   /// free again — the cancellation latency the service promises to keep under 100 ms.
   std::optional<double> stop_ms;
+  /// Codes of the modeling's warnings in the answer (ModelingWarning.code), e.g.
+  /// "tube_length_shorter_than_scan": the call succeeded, but a cell input probably does not fit.
+  std::vector<std::string> warnings;
 };
 
 /// `call rpc=PlanPick id=… peer=… code=OK points=… tubes=… plans=… queue_ms=… run_ms=… total_ms=…`
-/// (+ `stop_ms=…` and `message="…"` when set).
+/// (+ `stop_ms=…`, `warnings=a,b` and `message="…"` when set).
 std::string FormatCallText(const CallRecord& record);
 /// The same fields as one JSON object (`{"event":"call","rpc":…}`), strings escaped.
 std::string FormatCallJson(const CallRecord& record);

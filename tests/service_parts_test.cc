@@ -341,6 +341,19 @@ TEST(RequestLog, JsonLineIsValidJsonWithEveryField) {
   EXPECT_FALSE(k.contains("stop_ms"));
 }
 
+TEST(RequestLog, AnAnswersWarningsAreInItsLine) {
+  CallRecord r = SampleRecord();
+  r.code = "OK";
+  r.message.clear();
+  r.stop_ms.reset();
+  r.warnings = {"tube_length_shorter_than_scan", "other"};
+  EXPECT_THAT(FormatCallText(r),
+              ::testing::EndsWith(" total_ms=21.5 warnings=tube_length_shorter_than_scan,other"));
+  const nlohmann::json j = nlohmann::json::parse(FormatCallJson(r));
+  EXPECT_EQ(j["warnings"], nlohmann::json({"tube_length_shorter_than_scan", "other"}));
+  EXPECT_FALSE(nlohmann::json::parse(FormatCallJson(SampleRecord())).contains("warnings"));
+}
+
 TEST(RequestLog, JsonFormatterWritesOneObjectPerLine) {
   std::ostringstream out;
   auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(out);

@@ -294,6 +294,56 @@ TEST_F(ServiceRpc, AFullyGivenCellIsUsed) {
   EXPECT_EQ(response.tubes_size(), 3);
 }
 
+TEST_F(ServiceRpc, ATubeLengthShorterThanTheScanShowsIsAnsweredWithAWarning) {
+  // The three rendered tubes are 0.46-0.50 m long; a cell that says 0.30 m gets its tubes whole
+  // (joined within the length the scan shows), and a warning with both lengths, in ModelTubes and
+  // PlanPick alike, counted in the metrics by code.
+  const std::string series = "tubepick_modeling_warnings_total{code=\"tube_length_shorter_than_scan\"}";
+  const double before = MetricValue(ScrapeMetrics(server_->metrics_port()), series).value_or(0.0);
+  v1::ModelTubesRequest model = ModelRequest(ThreeTubeCloud());
+  *model.mutable_cell() = DefaultCell();
+  model.mutable_cell()->set_tube_length(0.30);
+  v1::ModelTubesResponse modeled;
+  ASSERT_TRUE(ModelTubes(model, &modeled).ok());
+  EXPECT_EQ(modeled.tubes_size(), 3);
+  ASSERT_EQ(modeled.warnings_size(), 1);
+  const v1::ModelingWarning& w = modeled.warnings(0);
+  EXPECT_EQ(w.code(), "tube_length_shorter_than_scan");
+  EXPECT_DOUBLE_EQ(w.stated(), 0.30);
+  EXPECT_NEAR(w.observed(), 0.48, 0.03);
+  EXPECT_THAT(w.message(), HasSubstr("tube.length 0.300 m"));
+  EXPECT_THAT(w.message(), HasSubstr("whole curve length"));
+
+  v1::PlanPickRequest plan = PlanRequest(ThreeTubeCloud());
+  *plan.mutable_cell() = DefaultCell();
+  plan.mutable_cell()->set_tube_length(0.30);
+  v1::PlanPickResponse planned;
+  ASSERT_TRUE(PlanPick(plan, &planned).ok());
+  ASSERT_EQ(planned.modeling().warnings_size(), 1);
+  EXPECT_EQ(planned.modeling().warnings(0).code(), "tube_length_shorter_than_scan");
+  EXPECT_EQ(planned.tubes_size(), 3);
+  EXPECT_EQ(MetricValue(ScrapeMetrics(server_->metrics_port()), series).value_or(0.0), before + 2.0);
+
+  // The right length: no warning.
+  model.mutable_cell()->set_tube_length(0.50);
+  ASSERT_TRUE(ModelTubes(model, &modeled).ok());
+  EXPECT_EQ(modeled.warnings_size(), 0);
+}
+
+TEST_F(ServiceRpc, ACellRadiusTheModelingCannotFitIsInvalidAndOneTheScanDoesNotShowIsWarned) {
+  v1::ModelTubesRequest request = ModelRequest(ThreeTubeCloud());
+  *request.mutable_cell() = DefaultCell();
+  request.mutable_cell()->set_tube_radius(0.020);  // the fast profile fits 7-18 mm
+  ExpectInvalid(ModelTubes(request), "tube.radius: 0.0200 m", "outside the radii the modeling fits");
+  request.mutable_cell()->set_tube_radius(0.009);  // the rendered tubes are 12.5 mm
+  v1::ModelTubesResponse response;
+  ASSERT_TRUE(ModelTubes(request, &response).ok());
+  EXPECT_EQ(response.tubes_size(), 3);
+  ASSERT_EQ(response.warnings_size(), 1);
+  EXPECT_EQ(response.warnings(0).code(), "tube_radius_differs_from_scan");
+  EXPECT_NEAR(response.warnings(0).observed(), 0.0125, 0.001);
+}
+
 TEST_F(ServiceRpc, GarbageCloudsNeverCrashTheServer) {
   // Random bytes (NaNs, infinities, 1e38 coordinates, denormals) and all-NaN clouds: each answer is
   // OK, INVALID_ARGUMENT or (a cloud that misses the bin) FAILED_PRECONDITION, never INTERNAL, and

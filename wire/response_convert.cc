@@ -83,6 +83,13 @@ v1::ModelTubesResponse ToModelTubesResponse(const ModelingResult& result, const 
   response.set_total_seconds(result.total_seconds);
   response.set_profile(profile);
   response.set_seed(seed);
+  for (const ModelingWarning& w : result.warnings) {
+    v1::ModelingWarning* pw = response.add_warnings();
+    pw->set_code(w.code);
+    pw->set_message(w.message);
+    pw->set_stated(w.stated);
+    pw->set_observed(w.observed);
+  }
   return response;
 }
 

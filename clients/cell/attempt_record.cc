@@ -6,7 +6,7 @@
 namespace tubepick::cell {
 
 nlohmann::json AttemptRecord(const AttemptRecordHead& head, const v1::PlanPickResponse& response) {
-  return nlohmann::json{{"type", "attempt"},
+  nlohmann::json record{{"type", "attempt"},
                         {"round", head.round},
                         {"attempt", head.attempt},
                         {"scan", head.scan},
@@ -17,6 +17,14 @@ nlohmann::json AttemptRecord(const AttemptRecordHead& head, const v1::PlanPickRe
                         {"bin_empty", response.bin_empty()},
                         {"used_simulation", response.used_simulation()},
                         {"truth_before", head.truth_before}};
+  // The modeling's warnings about the cell's inputs (e.g. a tube.length shorter than the scan shows).
+  if (response.modeling().warnings_size() > 0) {
+    nlohmann::json& warnings = record["planner_warnings"] = nlohmann::json::array();
+    for (const v1::ModelingWarning& w : response.modeling().warnings()) {
+      warnings.push_back({{"code", w.code()}, {"stated", w.stated()}, {"observed", w.observed()}});
+    }
+  }
+  return record;
 }
 
 nlohmann::json PlanningDurationsJson(double planning_wall_s, double planning_server_s) {

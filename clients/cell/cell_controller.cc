@@ -261,6 +261,13 @@ void CellController::PlanPick(const devices::Capture& capture, PlannedScan& scan
   spdlog::info("cell: round {} scan {}: {} tubes modeled, {} plans{}{} ({:.2f} s)", round_, scan.index,
                response.tubes_size(), response.plans_size(), response.used_simulation() ? ", simulated" : "",
                response.bin_empty() ? ", BIN EMPTY" : "", scan.planning_wall_s);
+  // The planner's doubts about this cell's inputs: loud the first time, then in the records only.
+  for (const v1::ModelingWarning& w : response.modeling().warnings()) {
+    const bool first = planner_warnings_seen_.insert(w.code()).second;
+    spdlog::log(first ? spdlog::level::warn : spdlog::level::debug, "cell: the planner warns ({}): {}{}",
+                w.code(), w.message(),
+                first ? " (said once; every attempt record lists it as planner_warnings)" : "");
+  }
 }
 
 // ---------------------------------------------------------------- attempts

@@ -5,6 +5,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -457,6 +458,8 @@ class CellController {
   /// that the safe stop can tell whether opening over the bin shed it.
   std::optional<devices::WrenchReading> caught_reference_;
   std::uint32_t round_ = 0;
+  /// Codes of the planner's modeling warnings already logged (PlanPick logs each once).
+  std::set<std::string> planner_warnings_seen_;
   /// A stop was requested (RequestStop); stop_why_ (under stop_mutex_) is set before it.
   std::atomic<bool> stop_requested_{false};
   mutable std::mutex stop_mutex_;

@@ -34,8 +34,6 @@
 #include <optional>
 #include <tuple>
 
-#include <spdlog/spdlog.h>
-
 #include "core/common/errors.h"
 #include "core/common/require.h"
 #include "core/common/segment_geometry.h"
@@ -733,8 +731,8 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
 
 JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const JunctionParams& params,
                                       JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                                      double tube_length, bool* length_disagrees) {
-  if (length_disagrees != nullptr) *length_disagrees = false;
+                                      double tube_length, std::optional<double>* scan_length) {
+  if (scan_length != nullptr) scan_length->reset();
   if (!(tube_length > 0.0)) return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
   // The trees within max_tube_length alone: how long are the ones seen about whole? Four of them
   // at least: in a bin of two or three trees one merge can be the median (a 3-tree bin of set C).
@@ -745,11 +743,7 @@ JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const Jun
   if (whole <= MaxTreeLength(params, tube_length)) {
     return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
   }
-  spdlog::warn(
-      "tube.length {:.3f} m: the branched tubes this scan shows about whole are {:.3f} m long (median), more "
-      "than {:.2f} times it; is tube.length all branches of a part together? Joined as if it were {:.3f} m",
-      tube_length, whole, params.max_length_share, whole);
-  if (length_disagrees != nullptr) *length_disagrees = true;
+  if (scan_length != nullptr) *scan_length = whole;
   return JoinJunctions(chains, params, shape, stop, rooms, whole);
 }
 

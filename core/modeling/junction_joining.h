@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -181,11 +182,11 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
 
 /// JoinJunctions for a cell whose tubes are `tube_length` long (0 = unknown), unless the trees
 /// the scan shows about whole (joined within max_tube_length alone, WholeTubeLength) are longer
-/// than the tree bound of that length: then as if the tubes were that long, with a warning that
-/// names tube.length and what the scan shows, and `length_disagrees` (optional) set.
+/// than the tree bound of that length: then as if the tubes were that long, and `scan_length`
+/// (optional) receives that length (else nullopt) for the caller to say so.
 JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const JunctionParams& params,
                                       JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                                      double tube_length, bool* length_disagrees = nullptr);
+                                      double tube_length, std::optional<double>* scan_length = nullptr);
 
 /// Topology `auto`: whether a scene shows branched tubes (at least auto_min_junctions junctions
 /// and auto_min_per_tube per tube joining left, or at least auto_min_y_pieces Y-pieces).

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include <fmt/core.h>
 #include <spdlog/spdlog.h>
 
 #include "core/common/errors.h"
@@ -63,6 +64,90 @@ Points UnfittedPoints(const Points& points,
   return out;
 }
 
+// The cylinders joined into tubes: linear (JoinTubesOfLength) or, for a branched or `auto` cell,
+// chains joined within stricter limits first (JunctionParams::chain_max_distance), then into trees;
+// `auto` keeps the plain linear joining when the scene does not look branched. `scan_length`: the
+// whole tubes' length when the cell's tube.length is shorter than the scan shows.
+std::vector<Tube> JoinModeledTubes(const ModelingInput& input, const ModelingParams& params,
+                                   const std::vector<Cylinder>& cylinders, const Points& unfitted,
+                                   const RangeImage* seen, const StopToken* stop,
+                                   std::optional<double>* scan_length) {
+  if (input.topology == TubeTopology::kLinear) {
+    return JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop, scan_length);
+  }
+  JoiningParams chain_joining = params.joining;
+  chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
+  chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
+  const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
+  const EndRooms rooms = MeasureEndRooms(unfitted, chains, params.junctions.end_room, seen);
+  JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop, rooms,
+                                                 input.tube_length, scan_length);
+  const bool branched = input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
+  spdlog::debug(
+      "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
+      joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
+      joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
+  if (branched) return std::move(joined.tubes);
+  return JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop, scan_length);
+}
+
+// The cell's tube radius must be one the cylinder fit can find: outside its radii every tube would
+// be fitted at a bound (or not at all), a plausible-looking but wrong model.
+void RequireRadiusWithinFit(double tube_radius, const CylinderFitParams& cylinders) {
+  if (tube_radius <= 0.0) return;  // unknown
+  if (tube_radius < cylinders.min_radius || tube_radius > cylinders.max_radius) {
+    throw InvalidArgument(fmt::format(
+        "tube.radius: {:.4f} m lies outside the radii the modeling fits, [{:.4f}, {:.4f}] m "
+        "(modeling.cylinders.min_radius, max_radius): every tube would be fitted wrong; is tube.radius "
+        "the radius (not the diameter), in metres? Otherwise widen the fit's radii",
+        tube_radius, cylinders.min_radius, cylinders.max_radius));
+  }
+}
+
+// The fitted cylinders' median radius differs from the cell's tube.radius by more than a fifth
+// (fits of the right radius fall within a few per cent of it: docs/ACCURACY.md): a warning.
+std::optional<ModelingWarning> TubeRadiusWarning(double tube_radius, const std::vector<Cylinder>& cylinders) {
+  constexpr double kTolerance = 0.2;
+  if (tube_radius <= 0.0 || cylinders.empty()) return std::nullopt;
+  std::vector<double> radii;
+  for (const Cylinder& c : cylinders) radii.push_back(c.radius);
+  const auto mid = radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2);
+  std::nth_element(radii.begin(), mid, radii.end());
+  const double fitted = *mid;
+  if (std::abs(fitted - tube_radius) <= kTolerance * tube_radius) return std::nullopt;
+  ModelingWarning w;
+  w.code = "tube_radius_differs_from_scan";
+  w.stated = tube_radius;
+  w.observed = fitted;
+  w.message = fmt::format(
+      "tube.radius {:.4f} m: the {} cylinders fitted to this scan have a median radius of {:.4f} m, {:.0f} % "
+      "{}; is tube.radius the parts' outer radius? Grasp widths, escape distances and simulation use "
+      "tube.radius",
+      tube_radius, cylinders.size(), fitted, 100.0 * std::abs(fitted / tube_radius - 1.0),
+      fitted > tube_radius ? "more" : "less");
+  spdlog::warn("{}", w.message);
+  return w;
+}
+
+// The cell's tube.length is shorter than the tubes the scan shows whole (`scan_length`, their
+// median length): joined within the scan's length instead, and said, with the likely cause.
+ModelingWarning TubeLengthWarning(const ModelingInput& input, const ModelingParams& params,
+                                  double scan_length) {
+  const bool trees = input.topology != TubeTopology::kLinear;
+  const double share = trees ? params.junctions.max_length_share : params.joining.max_length_share;
+  ModelingWarning w;
+  w.code = "tube_length_shorter_than_scan";
+  w.stated = input.tube_length;
+  w.observed = scan_length;
+  w.message = fmt::format(
+      "tube.length {:.3f} m: the {}tubes this scan shows about whole are {:.3f} m long (median), more than "
+      "{:.2f} times it; is tube.length {}? Joined as if it were {:.3f} m",
+      input.tube_length, trees ? "branched " : "", scan_length, share,
+      trees ? "all branches of a part together" : "the parts' whole curve length", scan_length);
+  spdlog::warn("{}", w.message);
+  return w;
+}
+
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // SplitMix64: derives independent, reproducible seeds for each stochastic step.
@@ -108,6 +193,7 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
                           " bytes is not a multiple of 12 (packed float32 x, y, z per point)");
   }
   params.Validate();
+  RequireRadiusWithinFit(input.tube_radius, params.cylinders);
   const Clock::time_point t_start = Clock::now();
   ModelingResult result;
 
@@ -225,45 +311,21 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
     }
   }
   result.cylinder_count = static_cast<std::uint32_t>(cylinders.size());
+  if (auto warning = TubeRadiusWarning(input.tube_radius, cylinders)) result.warnings.push_back(*warning);
   result.counts.push_back({"cylinder_inliers", fitted});
   result.timings.push_back({"cylinders", SecondsSince(t0)});
   ThrowIfStopped(stop, "cylinders");
 
-  // 5. Tube joining, with the visibility range image of the filtered cloud.
+  // 5. Tube joining, with the visibility range image of the filtered cloud; 6. junctions.
   t0 = Clock::now();
   std::optional<RangeImage> visibility;
   if (params.joining.visibility_check && !cloud.points.empty()) {
     visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
   }
-  const RangeImage* seen = visibility ? &*visibility : nullptr;
-  if (input.topology == TubeTopology::kLinear) {
-    result.tubes = JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop,
-                                     &result.tube_length_disagrees);
-  } else {
-    // 6. Junctions. Chains are joined within stricter limits first (JunctionParams::
-    // chain_max_distance), then into trees; `auto` keeps the plain linear joining when the scene
-    // does not look branched.
-    JoiningParams chain_joining = params.joining;
-    chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
-    chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
-    const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
-    const EndRooms rooms =
-        MeasureEndRooms(UnfittedPoints(cloud.points, inliers_of), chains, params.junctions.end_room, seen);
-    JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop,
-                                                   rooms, input.tube_length, &result.tube_length_disagrees);
-    const bool branched =
-        input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
-    spdlog::debug(
-        "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
-        joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
-        joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
-    if (branched) {
-      result.tubes = std::move(joined.tubes);
-    } else {
-      result.tubes = JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop,
-                                       &result.tube_length_disagrees);
-    }
-  }
+  std::optional<double> scan_length;
+  result.tubes = JoinModeledTubes(input, params, cylinders, UnfittedPoints(cloud.points, inliers_of),
+                                  visibility ? &*visibility : nullptr, stop, &scan_length);
+  if (scan_length) result.warnings.push_back(TubeLengthWarning(input, params, *scan_length));
   result.tube_of_point = TubeOfPoint(result.tubes, cylinders, inliers_of, cloud.size());
   result.timings.push_back({"joining", SecondsSince(t0)});
 
@@ -272,6 +334,17 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
                 result.tubes.size(), result.input_points, cloud.size(), result.segment_count,
                 result.cylinder_count, result.total_seconds);
   return result;
+}
+
+ModelingInput ModelingInputFor(const CellConfig& cell) {
+  ModelingInput input;
+  input.X_BinSensor = cell.sensor.X_BinSensor;
+  input.bin = cell.bin;
+  input.topology = cell.tube.topology;
+  input.junction_shape = cell.tube.junction_shape;
+  input.tube_length = cell.tube.length;
+  input.tube_radius = cell.tube.radius;
+  return input;
 }
 
 void DumpStages(const ModelingResult& result, const std::string& directory) {

@@ -36,11 +36,32 @@ struct ModelingInput {
   /// The length of one tube (CellConfig tube.length), metres; 0 = unknown. Bounds joining
   /// (JoinTubesOfLength, and the junction joining's trees and completion).
   double tube_length = 0.0;
+  /// The radius of the cell's tubes (CellConfig tube.radius), metres; 0 = unknown. Must lie within
+  /// the cylinder fit's radii (modeling.cylinders.min_radius, max_radius); the fitted radii are
+  /// compared with it (ModelingResult::warnings).
+  double tube_radius = 0.0;
 };
+
+/// The cell's part of a modeling input: bin, X_BinSensor, tube topology, junction shape, length
+/// and radius (the cloud, unit, seed and raw region are the caller's).
+ModelingInput ModelingInputFor(const CellConfig& cell);
 
 struct StageTiming {
   std::string stage;  ///< "prepare", "filter", "normals", "segmentation", "cylinders", "joining"
   double seconds = 0.0;
+};
+
+/// Something the modeling noticed that the caller should act on: the answer is given, but an input
+/// probably does not fit the parts in the bin.
+struct ModelingWarning {
+  /// Stable identifier for programs: "tube_length_shorter_than_scan",
+  /// "tube_radius_differs_from_scan".
+  std::string code;
+  /// What was seen, the values, and the likely cause, for a person.
+  std::string message;
+  /// The input's value and what the scan shows instead (same unit; metres for lengths).
+  double stated = 0.0;
+  double observed = 0.0;
 };
 
 struct StepCount {
@@ -56,9 +77,9 @@ struct ModelingResult {
   std::uint64_t dropped_non_finite = 0;
   /// How the finite input fits the bin (points inside, floor seen, extent).
   CloudPlausibility plausibility;
-  /// The scene's whole tubes were longer than the cell's tube.length allows (JoinTubesOfLength):
-  /// joined within their length instead, and a warning logged.
-  bool tube_length_disagrees = false;
+  /// What the caller should know about its inputs (also logged): e.g. the scene's whole tubes were
+  /// longer than the cell's tube.length allows, and were joined within their own length instead.
+  std::vector<ModelingWarning> warnings;
   std::uint32_t segment_count = 0;
   std::uint32_t cylinder_count = 0;
   std::vector<StepCount> counts;

@@ -45,8 +45,6 @@
 #include <string>
 #include <vector>
 
-#include <spdlog/spdlog.h>
-
 #include "core/common/errors.h"
 #include "core/common/require.h"
 
@@ -426,19 +424,13 @@ std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const Joinin
 
 std::vector<Tube> JoinTubesOfLength(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
                                     double tube_length, const RangeImage* visibility, const StopToken* stop,
-                                    bool* length_disagrees) {
-  if (length_disagrees != nullptr) *length_disagrees = false;
+                                    std::optional<double>* scan_length) {
+  if (scan_length != nullptr) scan_length->reset();
   const double stated_bound = MaxJoinedLength(params, tube_length);
   std::vector<Tube> unbounded = JoinTubes(cylinders, params, visibility, stop);
   if (stated_bound == params.max_tube_length) return unbounded;  // no share, or the absolute limit is smaller
   const double whole = WholeTubeLength(unbounded, tube_length);
-  if (whole > stated_bound) {
-    spdlog::warn(
-        "tube.length {:.3f} m: the tubes this scan shows about whole are {:.3f} m long (median), more than "
-        "{:.2f} times it; is tube.length the parts' whole curve length? Joined up to {:.2f} times {:.3f} m",
-        tube_length, whole, params.max_length_share, params.max_length_share, whole);
-    if (length_disagrees != nullptr) *length_disagrees = true;
-  }
+  if (whole > stated_bound && scan_length != nullptr) *scan_length = whole;
   const double bound = MaxJoinedLength(params, std::max(tube_length, whole));
   if (bound == params.max_tube_length) return unbounded;
   JoiningParams bounded = params;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/common/stop_token.h"
@@ -88,11 +89,11 @@ std::vector<Tube> JoinTubes(const std::vector<Cylinder>& cylinders, const Joinin
 
 /// JoinTubes for a cell whose tubes are `tube_length` long (0 = unknown): no tube longer than
 /// MaxJoinedLength of the longer of tube_length and the scene's WholeTubeLength. When the scene's
-/// whole tubes are longer than that bound of tube_length alone, a warning names tube.length and
-/// what the scan shows, and `length_disagrees` (optional) is set: the cell's tube.length is
-/// probably shorter than its parts.
+/// whole tubes are longer than that bound of tube_length alone, `scan_length` (optional) receives
+/// their length (else nullopt): the cell's tube.length is probably shorter than its parts, and the
+/// caller says so (ModelingResult::warnings).
 std::vector<Tube> JoinTubesOfLength(const std::vector<Cylinder>& cylinders, const JoiningParams& params,
                                     double tube_length, const RangeImage* visibility, const StopToken* stop,
-                                    bool* length_disagrees = nullptr);
+                                    std::optional<double>* scan_length = nullptr);
 
 }  // namespace tubepick

@@ -160,10 +160,35 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_DOUBLE_EQ(a["wrench"]["lift"]["force"][2].get<double>(), 0.64);
   EXPECT_EQ(a["resolution"]["used"], 0);
   EXPECT_EQ(a["result"], "picked");
+  EXPECT_FALSE(a.contains("planner_warnings"));
   EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_Bin_grasp.x());
   EXPECT_GE(a["durations"]["planning_wall_s"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(a["durations"]["planning_server_s"].get<double>(), 0.5);
   EXPECT_EQ(Records("end").at(0)["picks"], 1);
+}
+
+TEST_F(CellControllerTest, ThePlannersWarningsAboutTheCellAreInEveryAttemptRecord) {
+  // The planner answers with its plans and a warning that the cell's tube.length is too short: the
+  // controller picks as planned and each attempt record carries the warning's code and values.
+  auto answer = Plans({MakePlan(4, p_Bin_grasp)}, 1);
+  v1::ModelingWarning* w = answer.response.mutable_modeling()->add_warnings();
+  w->set_code("tube_length_shorter_than_scan");
+  w->set_message("tube.length 0.300 m: ...");
+  w->set_stated(0.30);
+  w->set_observed(0.48);
+  planner.plan_answers.push_back(answer);
+  ft.readings = {Reading(0.10), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  EXPECT_EQ(Run().picks, 1u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 1u);
+  ASSERT_TRUE(attempts[0].contains("planner_warnings"));
+  const json& recorded = attempts[0]["planner_warnings"];
+  ASSERT_EQ(recorded.size(), 1u);
+  EXPECT_EQ(recorded[0]["code"], "tube_length_shorter_than_scan");
+  EXPECT_DOUBLE_EQ(recorded[0]["stated"].get<double>(), 0.30);
+  EXPECT_DOUBLE_EQ(recorded[0]["observed"].get<double>(), 0.48);
 }
 
 TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) {

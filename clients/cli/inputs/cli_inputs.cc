@@ -56,15 +56,10 @@ CloudInput LoadCloudInput(const InputOptions& o, const CellConfig& cell) {
 
 ModelingInput MakeModelingInput(const Points& points_Sensor, LengthUnit unit, const CellConfig& cell,
                                 std::uint64_t seed, const RawRegion& raw_region_Bin) {
-  ModelingInput input;
+  ModelingInput input = ModelingInputFor(cell);
   input.raw_region_Bin = raw_region_Bin;
   input.points_Sensor = &points_Sensor;
   input.unit = unit;
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.topology = cell.tube.topology;
-  input.junction_shape = cell.tube.junction_shape;
-  input.tube_length = cell.tube.length;
   input.seed = seed;
   return input;
 }

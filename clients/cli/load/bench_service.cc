@@ -97,13 +97,8 @@ Stages InProcessCall(const BenchCloud& cloud, const Params& params, std::uint32_
   const CellConfig cell;
   const std::string xyz = PackXyz(cloud.points_Sensor);
   const Clock::time_point t0 = Clock::now();
-  ModelingInput input;
+  ModelingInput input = ModelingInputFor(cell);
   input.xyz_Sensor = PackedXyz{xyz};
-  input.X_BinSensor = cell.sensor.X_BinSensor;
-  input.bin = cell.bin;
-  input.topology = cell.tube.topology;
-  input.junction_shape = cell.tube.junction_shape;
-  input.tube_length = cell.tube.length;
   input.raw_region_Bin = RawRegionForPlanning(params.planning, cell.bin);
   ModelingParams modeling_params = params.modeling;
   modeling_params.threads = threads;

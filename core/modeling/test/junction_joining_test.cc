@@ -158,23 +158,24 @@ std::vector<Tube> YPieces(int count) {
 
 TEST(JunctionJoining, ATubeLengthShorterThanFourWholeTreesShowIsNotBelieved) {
   const JunctionParams params;
-  bool disagrees = true;
+  std::optional<double> disagrees = 1.0;
   // The cell's length right: four trees, as JoinJunctions makes them.
   EXPECT_EQ(JoinJunctionsOfLength(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.575, &disagrees)
                 .tubes.size(),
             4u);
-  EXPECT_FALSE(disagrees);
+  EXPECT_FALSE(disagrees.has_value());
   // Said to be 0.50 m: bound by it, every Y would be refused (0.575 > 0.52 m). The four trees the
   // scan shows whole are 0.575 m (median), so they are joined as that long, and it is said.
   ASSERT_GT(JoinJunctions(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.50).tubes.size(), 4u);
   EXPECT_EQ(JoinJunctionsOfLength(YPieces(4), params, JunctionShape::kAny, nullptr, {}, 0.50, &disagrees)
                 .tubes.size(),
             4u);
-  EXPECT_TRUE(disagrees);
+  ASSERT_TRUE(disagrees.has_value());
+  EXPECT_NEAR(*disagrees, 0.575, 0.01);
   // Three trees are too few to overrule the cell (in a bin of three, one merge can be the median).
   const JunctionJoining three =
       JoinJunctionsOfLength(YPieces(3), params, JunctionShape::kAny, nullptr, {}, 0.50, &disagrees);
-  EXPECT_FALSE(disagrees);
+  EXPECT_FALSE(disagrees.has_value());
   EXPECT_EQ(three.tubes.size(),
             JoinJunctions(YPieces(3), params, JunctionShape::kAny, nullptr, {}, 0.50).tubes.size());
   EXPECT_GT(three.tubes.size(), 3u);

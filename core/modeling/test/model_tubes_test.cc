@@ -152,7 +152,7 @@ TEST(ModelTubes, TheCellsTubeLengthBoundsLinearJoining) {
   // are 0.40 m, the median of 0.36, 0.40, 0.40 and 0.70).
   const ModelingResult bounded = model(0.40);
   EXPECT_EQ(bounded.tubes.size(), 5u);
-  EXPECT_FALSE(bounded.tube_length_disagrees);
+  EXPECT_TRUE(bounded.warnings.empty());
   params.joining.max_length_share = 0.0;  // off
   EXPECT_EQ(model(0.40).tubes.size(), 4u);
 }
@@ -168,8 +168,55 @@ TEST(ModelTubes, ATubeLengthShorterThanTheScanShowsIsNotBelieved) {
   input.seed = 7;
   input.tube_length = 0.30;
   const ModelingResult r = ModelTubes(input, params);
-  EXPECT_TRUE(r.tube_length_disagrees);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  const ModelingWarning& w = r.warnings[0];
+  EXPECT_EQ(w.code, "tube_length_shorter_than_scan");
+  EXPECT_DOUBLE_EQ(w.stated, 0.30);
+  EXPECT_NEAR(w.observed, 0.40, 0.02);
+  EXPECT_NE(w.message.find("tube.length 0.300 m"), std::string::npos) << w.message;
   EXPECT_EQ(r.tubes.size(), 5u);
+}
+
+TEST(ModelTubes, ACellRadiusTheFitCannotFindIsRefusedNamingBothRanges) {
+  // A 20 mm tube radius (or a 25 mm diameter given as radius) with the fast profile's fit radii of
+  // 7-18 mm: every cylinder would come out at 18 mm, a plausible but wrong model. Refused.
+  const Points cloud = WholeTubesAndALongOne();
+  ModelingInput input;
+  input.points_Sensor = &cloud;
+  input.tube_radius = 0.020;
+  try {
+    ModelTubes(input, FastModelingProfile());
+    FAIL() << "a radius outside the fit's radii was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("tube.radius: 0.0200 m lies outside the radii the modeling fits, "
+                                               "[0.0070, 0.0180] m"));
+  }
+  input.tube_radius = 0.0050;
+  EXPECT_THROW(ModelTubes(input, FastModelingProfile()), InvalidArgument);
+  input.tube_radius = 0.0180;  // the bound itself is fittable
+  EXPECT_NO_THROW(ModelTubes(input, FastModelingProfile()));
+}
+
+TEST(ModelTubes, ACellRadiusTheScanDoesNotShowIsWarnedAbout) {
+  // The rendered tubes are 12.5 mm in radius: a cell that says 9 mm is told (the fitted median),
+  // one that says 12.5 or 11 mm is not.
+  const Points cloud = WholeTubesAndALongOne();
+  ModelingInput input;
+  input.points_Sensor = &cloud;
+  input.seed = 7;
+  auto warnings = [&](double radius) {
+    input.tube_radius = radius;
+    return ModelTubes(input, FastModelingProfile()).warnings;
+  };
+  const std::vector<ModelingWarning> told = warnings(0.009);
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].code, "tube_radius_differs_from_scan");
+  EXPECT_DOUBLE_EQ(told[0].stated, 0.009);
+  EXPECT_NEAR(told[0].observed, 0.0125, 0.0008);
+  EXPECT_THAT(told[0].message, ::testing::HasSubstr("tube.radius 0.0090 m"));
+  EXPECT_TRUE(warnings(0.0125).empty());
+  EXPECT_TRUE(warnings(0.011).empty());
+  EXPECT_TRUE(warnings(0.0).empty());  // unknown
 }
 
 TEST(ModelTubes, MillimetreInputEqualsMetreInput) {

@@ -278,11 +278,11 @@ TEST(JoinTubesOfLength, NoTubeLongerThanTheShareOfTheCellsTubeLength) {
   params.max_tube_length = 0.8;
   params.max_length_share = 1.04;
   const std::vector<Cylinder> cylinders = TwoWholeTubesAndTwoPieces();
-  bool disagrees = true;
+  std::optional<double> disagrees = 1.0;
   // Joined without the share: the whole tubes are 0.50 m (median of 0.50, 0.50, 0.60).
   EXPECT_NEAR(WholeTubeLength(JoinTubes(cylinders, params, nullptr), 0.5), 0.5, kTol);
   EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.5, nullptr, nullptr, &disagrees).size(), 4u);  // ≤ 0.52 m
-  EXPECT_FALSE(disagrees);
+  EXPECT_FALSE(disagrees.has_value());
   EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.0, nullptr, nullptr, &disagrees).size(), 3u);  // unknown
   EXPECT_EQ(JoinTubesOfLength(cylinders, params, 0.6, nullptr, nullptr, &disagrees).size(), 3u);  // ≤ 0.624 m
   params.max_length_share = 0.0;
@@ -298,9 +298,10 @@ TEST(JoinTubesOfLength, ACellThatStatesItsTubesShorterThanTheScanShowsThemIsTold
   std::vector<Cylinder> cylinders = TwoWholeTubesAndTwoPieces();
   cylinders[0] = FloorCylinder(-0.30, -0.2, 0.30, -0.2, 0);
   cylinders[1] = FloorCylinder(-0.30, 0.2, 0.30, 0.2, 1);
-  bool disagrees = false;
+  std::optional<double> disagrees;
   const std::vector<Tube> tubes = JoinTubesOfLength(cylinders, params, 0.45, nullptr, nullptr, &disagrees);
-  EXPECT_TRUE(disagrees);
+  ASSERT_TRUE(disagrees.has_value());
+  EXPECT_NEAR(*disagrees, 0.6, 0.011);
   ASSERT_EQ(tubes.size(), 3u);
   for (const Tube& tube : tubes) EXPECT_NEAR(tube.length(), 0.6, 0.011);
 }
