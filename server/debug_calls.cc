@@ -2,6 +2,7 @@
 
 #include <fmt/chrono.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace tubepick::server {
 namespace {
@@ -45,12 +46,16 @@ std::string DebugCallStore::ListHtml() const {
   std::string rows;
   for (const auto& call : Calls()) {
     const CallRecord& r = call->record;
+    // An answered call's message column lists its modeling warnings (ModelingWarning.code).
+    const std::string message = r.message.empty() && !r.warnings.empty()
+                                    ? fmt::format("warnings: {}", fmt::join(r.warnings, ", "))
+                                    : r.message;
     rows += fmt::format(
         "<tr class=\"{}\"><td><a data-call-id=\"{}\" href=\"/debug/calls/{}\">call {}</a></td><td>{}</td>"
         "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.0f}</td><td>{}</td><td>{}</td></tr>\n",
         r.code == "OK" ? "ok" : "failed", call->id, call->id, call->id, UtcText(call->finished),
         viewer::HtmlEscape(r.rpc), viewer::HtmlEscape(r.code), r.points, r.tubes, r.plans, r.total_ms,
-        viewer::HtmlEscape(r.request_id), viewer::HtmlEscape(r.message));
+        viewer::HtmlEscape(r.request_id), viewer::HtmlEscape(message));
   }
   return fmt::format(
       "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>tubepick: last calls</title>"
@@ -73,13 +78,15 @@ std::string DebugCallStore::ListJson() const {
   bool first = true;
   for (const auto& call : Calls()) {
     const CallRecord& r = call->record;
+    std::string warnings;
+    for (const std::string& code : r.warnings)
+      warnings += fmt::format("{}\"{}\"", warnings.empty() ? "" : ",", JsonEscape(code));
     out += fmt::format(
         "{}{{\"id\":{},\"href\":\"/debug/calls/{}\",\"finished\":\"{}\",\"rpc\":\"{}\",\"code\":\"{}\","
         "\"message\":\"{}\",\"request_id\":\"{}\",\"points\":{},\"tubes\":{},\"plans\":{},\"total_ms\":{:.1f}"
-        ","
-        "\"has_cloud\":{}}}",
+        ",\"warnings\":[{}],\"has_cloud\":{}}}",
         first ? "" : ",", call->id, call->id, UtcText(call->finished), JsonEscape(r.rpc), JsonEscape(r.code),
-        JsonEscape(r.message), JsonEscape(r.request_id), r.points, r.tubes, r.plans, r.total_ms,
+        JsonEscape(r.message), JsonEscape(r.request_id), r.points, r.tubes, r.plans, r.total_ms, warnings,
         call->capture && call->capture->frame.cloud ? "true" : "false");
     first = false;
   }

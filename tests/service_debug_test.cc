@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/service_test_support.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick {
 namespace {
@@ -44,10 +45,14 @@ TEST(DebugCalls, TheLastCallsAreKeptWithTheirCloudResponseOrError) {
   }
   v1::PlanPickResponse plan;
   {
+    // The server's cell, but with its tubes said to be 0.30 m long (they are 0.46-0.50 m): answered
+    // with a warning, which the list shows.
+    v1::PlanPickRequest request = service_test::PlanRequest(service_test::ThreeTubeCloud());
+    CellConfig cell;
+    cell.tube.length = 0.30;
+    *request.mutable_cell() = ToCellDescription(cell, cell.sensor.X_BinSensor);
     grpc::ClientContext context;
-    ASSERT_TRUE(server.stub()
-                    .PlanPick(&context, service_test::PlanRequest(service_test::ThreeTubeCloud()), &plan)
-                    .ok());
+    ASSERT_TRUE(server.stub().PlanPick(&context, request, &plan).ok());
   }
   ASSERT_EQ(plan.tubes_size(), 3);
   ASSERT_GT(plan.plans_size(), 0);
@@ -70,6 +75,8 @@ TEST(DebugCalls, TheLastCallsAreKeptWithTheirCloudResponseOrError) {
   EXPECT_EQ(list[1]["id"], 2);
   EXPECT_EQ(list[1]["rpc"], "PlanPick");
   EXPECT_EQ(list[1]["tubes"], 3);
+  EXPECT_EQ(list[1]["warnings"], nlohmann::json({"tube_length_shorter_than_scan"}));
+  EXPECT_EQ(list[0]["warnings"], nlohmann::json::array());
   int status = 0;
   EXPECT_THAT(Get(port, "/debug/calls/1", &status), HasSubstr("call 1 is not kept"));
   EXPECT_EQ(status, 404);
@@ -100,6 +107,7 @@ TEST(DebugCalls, TheLastCallsAreKeptWithTheirCloudResponseOrError) {
   EXPECT_THAT(html, HasSubstr("<a data-call-id=\"3\" href=\"/debug/calls/3\">"));
   EXPECT_THAT(html, HasSubstr("<a data-call-id=\"2\" href=\"/debug/calls/2\">"));
   EXPECT_LT(html.find("data-call-id=\"3\""), html.find("data-call-id=\"2\""));
+  EXPECT_THAT(html, HasSubstr("<td>warnings: tube_length_shorter_than_scan</td>"));
   const std::string viewer = Get(port, "/debug/calls/2", &status);
   EXPECT_EQ(status, 200);
   EXPECT_THAT(viewer, HasSubstr("<script type=\"application/json\" id=\"tubepick-data\">"));

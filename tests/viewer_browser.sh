@@ -4,7 +4,8 @@
 # is not blank, show the tube and plan counts of its own JSON, and select a plan's tube on a click
 # (in the table and in 3-D). Pages checked, as a user gets them:
 #   1. `tubepick view` of the built-in scene, planned in-process
-#   2. `tubepick view --plan` of the JSON `tubepick plan --json` wrote for that cloud
+#   2. `tubepick view --plan` of the JSON `tubepick plan --json` wrote for that cloud, and of one
+#      planned with a cell that understates the tube length (the modeling's warning shown)
 #   3. a round page of `tubepick cell --sim --view DIR` (frames stepped through)
 #   4. a running tubepick-server with debug.keep_last: /debug/calls, then the newest call's page
 # Screenshots go to ARTIFACTS (default: build/artifacts/viewer) for a person to look at.
@@ -53,6 +54,17 @@ if "$CLI" view --seed 4 --plan "$WORK/plan.json" --out "$WORK/wrong.html" 2>"$WO
   fail "a plan of another cloud was accepted"
 fi
 grep -q "was made from a cloud of" "$WORK/wrong.err" || fail "unexpected message: $(cat "$WORK/wrong.err")"
+
+step "2b. a plan whose cell understates its tubes' length shows the modeling's warning"
+"$CLI" scene --tubes 6 --seed 3 --out "$WORK/short" >/dev/null || fail "tubepick scene"
+sed 's/^  length: 0\.5 /  length: 0.35 /' "$WORK/short/cell.yaml" >"$WORK/short/cell-short.yaml"
+grep -q '^  length: 0.35 ' "$WORK/short/cell-short.yaml" || fail "could not shorten tube.length in the scene's cell.yaml"
+"$CLI" plan --no-sim --cloud "$WORK/short/cloud.ply" --cell "$WORK/short/cell-short.yaml" --json "$WORK/short/plan.json" \
+  >/dev/null 2>"$WORK/short/plan.err" || fail "tubepick plan with the short cell"
+"$CLI" view --cloud "$WORK/short/cloud.ply" --cell "$WORK/short/cell-short.yaml" --plan "$WORK/short/plan.json" \
+  --out "$WORK/short.html" || fail "tubepick view --plan (short cell)"
+timeout 180 node "$CHECK" --page "$WORK/short.html" --screenshot "$ARTIFACTS/view-warning.png" \
+  --expect-warning tube_length_shorter_than_scan || fail "page check of $WORK/short.html"
 
 step "3. a round page of tubepick cell --sim --view"
 "$CLI" cell --sim --rounds 1 --tubes 3 --seed 2 --no-sim-planning --view "$WORK/rounds" --view-points 60000 \

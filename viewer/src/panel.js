@@ -44,6 +44,7 @@ export function buildFrameSection(m, h) {
     m.note ? el('div', { class: 'note' }, m.note) : null,
     m.error ? el('div', { class: 'frame-error', id: 'frame-error' }, m.error) : null,
     m.problems.map((p) => el('div', { class: 'frame-error data-problem' }, p)),
+    (m.modeling?.warnings || []).map((w) => el('div', { class: 'frame-warning', 'data-code': w.code || '' }, w.message || w.code)),
     el('h2', {}, 'Summary'), summary(m),
     el('h2', {}, `Tubes (${m.tubes.length})`), tubesTable(m, h),
     m.plans.length ? [el('h2', {}, 'Selected plan'), el('div', { id: 'plan-details', class: 'plan-details' })] : null,

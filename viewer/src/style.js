@@ -25,6 +25,8 @@ button:disabled { opacity:.4; cursor:default; }
 .frame-error { margin-top:8px; padding:8px 10px; border-radius:5px; background:#3a1d1f; border:1px solid var(--bad); color:#ffd0ce; font-weight:600; white-space:pre-wrap; }
 .frame-error::before { content:"Call failed: "; color:var(--bad); }
 .frame-error.data-problem::before { content:"Data problem: "; }
+.frame-warning { margin-top:8px; padding:8px 10px; border-radius:5px; background:#3a321a; border:1px solid #d9a520; color:#ffe8b0; white-space:pre-wrap; }
+.frame-warning::before { content:"Check the cell: "; color:#f2c14e; font-weight:600; }
 #plans td, #plans th { font-size:12px; padding:3px 4px; }
 table { width:100%; border-collapse:collapse; font-variant-numeric:tabular-nums; }
 th { text-align:left; color:var(--muted); font-weight:600; font-size:11px; padding:3px 5px; border-bottom:1px solid var(--line); white-space:nowrap; }

@@ -1,6 +1,6 @@
 #!/usr/bin/env node
 // Headless-Chromium check of a tubepick viewer page (file path, file:// or http URL), or of a call list page.
-//   node viewer/test/check-page.mjs --page PATH_OR_URL --screenshot OUT.png [--list]
+//   node viewer/test/check-page.mjs --page PATH_OR_URL --screenshot OUT.png [--list] [--expect-warning CODE]
 import { chromium } from 'playwright-core';
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -57,10 +57,11 @@ function expectedFrames(data) {
   return data.frames.map((f) => {
     const tubes = f.plan ? nonEmpty(f.plan.tubes) || nonEmpty(f.plan.modeling?.tubes) || [] : nonEmpty(f.modeling?.tubes) || [];
     const plans = Array.isArray(f.plan?.plans) ? f.plan.plans : [];
+    const warnings = ((f.plan ? f.plan.modeling : f.modeling)?.warnings || []).map((w) => w.code || '');
     const grasp = (p) => ['x', 'y', 'z'].map((k) => num(p.grasp?.tcpPose?.position?.[k]));
     return { tubeIds: tubes.map((t) => num(t.id)), planTubeIds: plans.map((p) => num(p.tubeId)), grasps: plans.map(grasp),
       certainties: plans.map((p) => String(p.certainty || '').replace(/^PLAN_CERTAINTY_/, '').toLowerCase() || '–'),
-      graphs: tubes.map(tubeGraph) };
+      graphs: tubes.map(tubeGraph), warnings };
   });
 }
 
@@ -229,8 +230,11 @@ async function checkFrame(page, f, i) {
     const v = window.tubepickViewer;
     return { idx: v.frameIndex, tubes: v.tubeCount(), plans: v.planCount(),
       tubeRows: document.querySelectorAll('#tubes tr[data-tube-id]').length,
-      planRows: document.querySelectorAll('#plans tr[data-plan-index]').length };
+      planRows: document.querySelectorAll('#plans tr[data-plan-index]').length,
+      warnings: [...document.querySelectorAll('#frame-section .frame-warning')].map((e) => e.dataset.code) };
   });
+  check(got.warnings.join(',') === f.warnings.join(','), `frame ${i + 1}: modeling warnings shown`,
+    `page [${got.warnings}], JSON [${f.warnings}]`);
   const nt = f.tubeIds.length, np = f.planTubeIds.length;
   check(got.idx === i && got.tubes === nt && got.tubeRows === nt && got.plans === np && got.planRows === np,
     `frame ${i + 1}: counts`, `tubeCount ${got.tubes}, tube rows ${got.tubeRows} (JSON ${nt}); planCount ${got.plans}, plan rows ${got.planRows} (JSON ${np})`);
@@ -338,7 +342,7 @@ async function exercise(page, frames) {
   }
 }
 
-async function checkViewerPage(page, url, consoleErrors) {
+async function checkViewerPage(page, url, consoleErrors, expectWarning) {
   const data = pageData(await fetchText(url));
   const frames = expectedFrames(data);
   if (page.url() !== url) await page.goto(url, { waitUntil: 'load' });
@@ -359,6 +363,10 @@ async function checkViewerPage(page, url, consoleErrors) {
     if (data.frames[0]?.cloud?.xyz) await checkCloudHover(page);
     for (let i = 0; i < frames.length; i++) await checkFrame(page, frames[i], i);
     await exercise(page, frames);
+  }
+  if (expectWarning) {
+    const shown = frames.filter((f) => f.warnings.includes(expectWarning)).length;
+    check(shown > 0, `the page carries warning ${expectWarning}`, `${shown} frame(s)`);
   }
   const branched = frames.reduce((s, f) => s + f.graphs.filter((g) => g.branches > 1).length, 0);
   check(consoleErrors.length === 0, 'no console or page errors', (consoleErrors.length ? consoleErrors.join(' | ') : '0 errors')
@@ -383,10 +391,11 @@ async function followList(page, url, consoleErrors) {
 async function main() {
   let args;
   try {
-    args = parseArgs({ options: { page: { type: 'string' }, screenshot: { type: 'string' }, list: { type: 'boolean' } } }).values;
+    args = parseArgs({ options: { page: { type: 'string' }, screenshot: { type: 'string' }, list: { type: 'boolean' },
+      'expect-warning': { type: 'string' } } }).values;
   } catch (e) { args = {}; console.error(e.message); }
   if (!args.page || !args.screenshot) {
-    console.error('usage: node viewer/test/check-page.mjs --page PATH_OR_URL --screenshot OUT.png [--list]');
+    console.error('usage: node viewer/test/check-page.mjs --page PATH_OR_URL --screenshot OUT.png [--list] [--expect-warning CODE]');
     process.exit(2);
   }
   const browser = await chromium.launch({ executablePath: process.env.CHROMIUM || '/usr/bin/chromium', args: LAUNCH_ARGS });
@@ -407,7 +416,7 @@ async function main() {
     if (args.list) url = await followList(page, url, consoleErrors);
     if (url) {
       requests.length = 0;
-      await checkViewerPage(page, url, consoleErrors);
+      await checkViewerPage(page, url, consoleErrors, args['expect-warning']);
       const extra = requests.filter((r) => r !== url && !r.startsWith('data:') && !r.startsWith('blob:') && !/\/favicon\.ico$/.test(r));
       check(extra.length === 0, 'self-contained (no requests besides the page)', extra.length ? extra.slice(0, 5).join(' ') : `${requests.length} request(s), all the page itself`);
       await api(page, 'v.showFrame(0)').catch(() => {});
