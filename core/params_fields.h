@@ -193,6 +193,9 @@ void DescribeFields(Visit& v, PlausibilityParams& p) {
   v("floor_tolerance", p.floor_tolerance, "on the floor: |z| at most this, m");
   v("min_floor_points", p.min_floor_points, "floor seen: at least this many points on it");
   v("min_floor_share", p.min_floor_share, "and this share of the points inside the bin volume");
+  v("wall_tolerance", p.wall_tolerance, "the scan's inner wall faces within this of the cell's, m; 0 = off");
+  v("wall_min_points", p.wall_min_points,
+    "a wall face is seen with this many sampled points per height band");
 }
 
 template <typename Visit>

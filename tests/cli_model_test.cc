@@ -127,6 +127,24 @@ TEST(CliModel, ACloudThatMissesTheBinIsExitCode4NeverBinEmpty) {
   fs::remove_all(dir);
 }
 
+TEST(CliModel, ACellWhoseBinIsLargerThanTheScannedOneIsExitCode4NotWallsModeledAsTubes) {
+  // The built-in scene's bin is 0.8 x 0.6 m; a cell that says 1.0 x 0.8 m would put the real walls
+  // inside its bin, where their faces and rims look like tubes.
+  const fs::path dir = TempDir("bigbin");
+  { std::ofstream(dir / "cell.yaml") << "bin:\n  inner_size: [1.0, 0.8, 0.2]\n"; }
+  ASSERT_EQ(RunCli("scene --tubes 4 --seed 1 --out " + (dir / "scene").string()).exit_code, 0);
+  for (const std::string command : {"model", "plan"}) {
+    const CliRun run = RunCli(command + " --cloud " + (dir / "scene" / "cloud.ply").string() + " --cell " +
+                              (dir / "cell.yaml").string());
+    EXPECT_EQ(run.exit_code, 4) << run.output;
+    EXPECT_THAT(run.output, HasSubstr("error: cloud does not fit the cell's bin: the -x wall at x = -0.400 m "
+                                      "(the cell: -0.500 m)"));
+    EXPECT_THAT(run.output, HasSubstr("Set larger than the bin, the walls would be modeled as tubes"));
+  }
+  EXPECT_EQ(RunCli("model --cloud " + (dir / "scene" / "cloud.ply").string()).exit_code, 0);
+  fs::remove_all(dir);
+}
+
 TEST(CliPlan, PlansTheBuiltInSceneAndWritesPlanPickResponse) {
   const fs::path dir = TempDir("plan");
   const CliRun run = RunCli("plan --tubes 4 --seed 2 --json " + (dir / "plan.json").string());

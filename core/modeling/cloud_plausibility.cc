@@ -45,6 +45,41 @@ std::string Direction(const Eigen::Vector3d& v) {
   return fmt::format("({:.2f}, {:.2f}, {:.2f})", c(v.x()), c(v.y()), c(v.z()));
 }
 
+// The scan's walls are not where the cell's bin puts them: both walls of an axis off the same way
+// is a shifted sensor pose; off in opposite ways, the bin's size.
+std::string DescribeMisfitWalls(const BinWalls& walls, const BinConfig& bin,
+                                const PlausibilityParams& params) {
+  BinWallParams wall_params;
+  wall_params.tolerance = params.wall_tolerance;
+  bool shifted = false;
+  int inside = 0, outside = 0;  // seen walls nearer the centre than the cell's, and farther
+  for (int w = 0; w < 4; ++w) {
+    if (!walls.seen[w] || std::abs(*walls.seen[w] - walls.expected[w]) <= params.wall_tolerance) continue;
+    (std::abs(*walls.seen[w]) < std::abs(walls.expected[w]) ? inside : outside) += 1;
+  }
+  for (int axis = 0; axis < 2; ++axis) {
+    const auto& lo = walls.seen[2 * axis];
+    const auto& hi = walls.seen[2 * axis + 1];
+    if (!lo || !hi) continue;
+    const double d_lo = *lo - walls.expected[2 * axis], d_hi = *hi - walls.expected[2 * axis + 1];
+    if (std::abs(d_lo - d_hi) <= params.wall_tolerance && std::abs(d_lo + d_hi) > 2.0 * params.wall_tolerance)
+      shifted = true;
+  }
+  const Eigen::Vector3d& s = bin.inner_size;
+  return fmt::format(
+      "cloud does not fit the cell's bin: {} (more than {:g} m off). {} "
+      "(modeling.plausibility.wall_tolerance; "
+      "0 turns this check off)",
+      DescribeBinWalls(walls, wall_params), params.wall_tolerance,
+      shifted
+          ? "The walls are shifted, not resized: is the sensor pose right (sensor.pose_in_bin, X_BinSensor)?"
+          : fmt::format("Is bin.inner_size [{:g}, {:g}, {:g}] m the bin's inner size, in metres? {}", s.x(),
+                        s.y(), s.z(),
+                        inside >= outside
+                            ? "Set larger than the bin, the walls would be modeled as tubes"
+                            : "Set smaller than the bin, tubes near the walls would be cropped away"));
+}
+
 }  // namespace
 
 void PlausibilityParams::Validate() const {
@@ -54,6 +89,7 @@ void PlausibilityParams::Validate() const {
   RequireInRange(min_inside_share, 0.0, 1.0, "modeling.plausibility.min_inside_share");
   RequirePositive(floor_tolerance, "modeling.plausibility.floor_tolerance");
   RequireInRange(min_floor_share, 0.0, 1.0, "modeling.plausibility.min_floor_share");
+  RequireNonNegative(wall_tolerance, "modeling.plausibility.wall_tolerance");
 }
 
 PlausibilityTally::PlausibilityTally(const BinConfig& bin, const PlausibilityParams& params,
@@ -111,6 +147,10 @@ CloudPlausibility PlausibilityTally::Finish() const {
     }
     const Eigen::Vector3d& s = bin_.inner_size;
     e.extent_ratio = e.extent.maxCoeff() / std::max({s.x(), s.y(), s.z()});
+    BinWallParams wall_params;
+    wall_params.tolerance = params_.wall_tolerance;
+    wall_params.min_points = params_.wall_min_points;
+    e.walls = FindBinWalls(sample_, bin_, wall_params);
   }
   return e;
 }
@@ -125,6 +165,7 @@ CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfi
 std::string DescribeImplausibleCloud(const CloudPlausibility& e, const BinConfig& bin, LengthUnit unit,
                                      const Eigen::Isometry3d& X_BinSensor, const PlausibilityParams& params) {
   const Eigen::Vector3d& s = bin.inner_size;
+  if (e.enough_inside && e.floor_seen && !e.walls.fit) return DescribeMisfitWalls(e.walls, bin, params);
   std::string text = fmt::format(
       "cloud does not fit the cell: {} of {} points ({:.1f} %) fall inside the bin volume "
       "(bin inner size {:g} × {:g} × {:g} m, {:g} m margin; at least {:.0f} % needed) and {} lie on "

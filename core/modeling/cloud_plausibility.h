@@ -9,6 +9,7 @@
 
 #include "core/common/cell_config.h"
 #include "core/common/types.h"
+#include "core/modeling/bin_walls.h"
 
 namespace tubepick {
 
@@ -30,6 +31,11 @@ struct PlausibilityParams {
   /// points inside the bin volume, lie on it.
   std::uint32_t min_floor_points = 50;
   double min_floor_share = 0.01;
+  /// The bin's inner wall faces, where the scan shows them (FindBinWalls), must lie within this of
+  /// where bin.inner_size puts them, metres; 0 = no wall check.
+  double wall_tolerance = 0.04;
+  /// A wall face counts as seen with at least this many sampled points per height band.
+  std::uint32_t wall_min_points = 30;
 
   /// @throws InvalidArgument naming the key ("modeling.plausibility.floor_tolerance", ...).
   void Validate() const;
@@ -51,8 +57,10 @@ struct CloudPlausibility {
   /// Largest extent over the bin's largest inner size (about 1 for a scan of the cell, about 1000
   /// for millimetres read as metres, about 0.001 for metres read as millimetres).
   double extent_ratio = 0.0;
+  /// The inner wall faces the scan shows, against the cell's bin.
+  BinWalls walls;
 
-  bool plausible() const { return enough_inside && floor_seen; }
+  bool plausible() const { return enough_inside && floor_seen && walls.fit; }
 };
 
 /// The evidence of CheckCloudAgainstCell, gathered one point at a time, so that the pass that brings
