@@ -344,6 +344,19 @@ TEST_F(ServiceRpc, ACellRadiusTheModelingCannotFitIsInvalidAndOneTheScanDoesNotS
   EXPECT_NEAR(response.warnings(0).observed(), 0.0125, 0.001);
 }
 
+TEST_F(ServiceRpc, ACellWhoseBinIsLargerThanTheScannedOneIsAFailedPrecondition) {
+  // BusyBinCloud scans the 0.8 x 0.6 m bin with its walls; a cell of 1.0 x 0.8 m would model them.
+  v1::PlanPickRequest request = PlanRequest(BusyBinCloud());
+  *request.mutable_cell() = DefaultCell();
+  SetVector(request.mutable_cell()->mutable_bin_inner_size(), 1.0, 0.8, 0.2);
+  const grpc::Status status = PlanPick(request);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("cloud does not fit the cell's bin: the -x wall at x = -0.40"));
+  EXPECT_THAT(status.error_message(), HasSubstr("Is bin.inner_size [1, 0.8, 0.2] m the bin's inner size"));
+  SetVector(request.mutable_cell()->mutable_bin_inner_size(), 0.8, 0.6, 0.2);
+  EXPECT_TRUE(PlanPick(request).ok());
+}
+
 TEST_F(ServiceRpc, GarbageCloudsNeverCrashTheServer) {
   // Random bytes (NaNs, infinities, 1e38 coordinates, denormals) and all-NaN clouds: each answer is
   // OK, INVALID_ARGUMENT or (a cloud that misses the bin) FAILED_PRECONDITION, never INTERNAL, and
