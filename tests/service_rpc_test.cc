@@ -351,7 +351,8 @@ TEST_F(ServiceRpc, ACellWhoseBinIsLargerThanTheScannedOneIsAFailedPrecondition) 
   SetVector(request.mutable_cell()->mutable_bin_inner_size(), 1.0, 0.8, 0.2);
   const grpc::Status status = PlanPick(request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION) << status.error_message();
-  EXPECT_THAT(status.error_message(), HasSubstr("cloud does not fit the cell's bin: the -x wall at x = -0.40"));
+  EXPECT_THAT(status.error_message(),
+              HasSubstr("cloud does not fit the cell's bin: the -x wall at x = -0.40"));
   EXPECT_THAT(status.error_message(), HasSubstr("Is bin.inner_size [1, 0.8, 0.2] m the bin's inner size"));
   SetVector(request.mutable_cell()->mutable_bin_inner_size(), 0.8, 0.6, 0.2);
   EXPECT_TRUE(PlanPick(request).ok());
