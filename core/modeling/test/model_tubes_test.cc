@@ -188,8 +188,9 @@ TEST(ModelTubes, ACellRadiusTheFitCannotFindIsRefusedNamingBothRanges) {
     ModelTubes(input, FastModelingProfile());
     FAIL() << "a radius outside the fit's radii was accepted";
   } catch (const InvalidArgument& e) {
-    EXPECT_THAT(e.what(), ::testing::HasSubstr("tube.radius: 0.0200 m lies outside the radii the modeling fits, "
-                                               "[0.0070, 0.0180] m"));
+    EXPECT_THAT(e.what(),
+                ::testing::HasSubstr("tube.radius: 0.0200 m lies outside the radii the modeling fits, "
+                                     "[0.0070, 0.0180] m"));
   }
   input.tube_radius = 0.0050;
   EXPECT_THROW(ModelTubes(input, FastModelingProfile()), InvalidArgument);
