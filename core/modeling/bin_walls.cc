@@ -1,6 +1,7 @@
 #include "core/modeling/bin_walls.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -13,14 +14,19 @@ constexpr int kBands = 4;
 constexpr double kBandLow = 0.4, kBandHigh = 0.9;  // of the wall height
 constexpr double kAwayFromCorners = 0.8;           // of the other half-extent
 constexpr double kBinWidth = 0.01;                 // metres
+constexpr int kSegments = 8;                       // along the wall, over its kAwayFromCorners span
+constexpr int kMinSegments = 6;                    // a face spans the wall: points in this many
 
 // Per height band, a histogram of the points' outward distance from the bin's centre line on one
 // side of one axis, 1 cm bins from 0 to the wall + search_beyond.
 struct WallHistogram {
   std::array<std::vector<std::uint32_t>, kBands> bands;
+  // Per band and bin: the segments along the wall its points fall in (bit s for segment s).
+  std::array<std::vector<std::uint8_t>, kBands> segments;
 
   explicit WallHistogram(std::size_t bins) {
     for (auto& b : bands) b.assign(bins, 0);
+    for (auto& s : segments) s.assign(bins, 0);
   }
   // The fullest adjacent pair of bins of `band`, starting at `bin`.
   std::uint32_t Pair(int band, std::size_t bin) const {
@@ -30,7 +36,8 @@ struct WallHistogram {
 };
 
 // The face of one wall: the adjacent pair of bins that is the fullest pair in every band (a tube
-// fills one or two bands), with at least min_points in each. Its outward distance, metres.
+// lying along the wall fills one or two bands), with at least min_points in each, and in each band
+// spread along the wall (a tube standing against it fills one segment). Its outward distance, metres.
 std::optional<double> FaceOf(const WallHistogram& h, std::uint32_t min_points) {
   std::optional<std::size_t> face;
   for (int band = 0; band < kBands; ++band) {
@@ -43,6 +50,11 @@ std::optional<double> FaceOf(const WallHistogram& h, std::uint32_t min_points) {
     // Another band's best pair may be its neighbour (the face split across bins): within one bin.
     if (face && (best + 1 < *face || best > *face + 1)) return std::nullopt;
     if (!face) face = best;
+  }
+  for (int band = 0; band < kBands; ++band) {
+    const auto& s = h.segments[band];
+    const std::uint8_t spread = s[*face] | (*face + 1 < s.size() ? s[*face + 1] : 0);
+    if (std::popcount(spread) < kMinSegments) return std::nullopt;
   }
   return (static_cast<double>(*face) + 1.0) * kBinWidth;  // the middle of the pair
 }
@@ -66,11 +78,16 @@ BinWalls FindBinWalls(const Points& sample_Bin, const BinConfig& bin, const BinW
     const int band = static_cast<int>(std::floor((p.z() - z_lo) / band_height));
     if (band < 0 || band >= kBands) continue;
     for (int axis = 0; axis < 2; ++axis) {
-      if (std::abs(p[1 - axis]) > kAwayFromCorners * half[1 - axis]) continue;
+      const double span = kAwayFromCorners * half[1 - axis];
+      if (std::abs(p[1 - axis]) > span) continue;
       const double out = std::abs(p[axis]);
       const std::size_t bin_index = static_cast<std::size_t>(out / kBinWidth);
       WallHistogram& h = histograms[2 * axis + (p[axis] < 0.0f ? 0 : 1)];
-      if (bin_index < h.bands[band].size()) ++h.bands[band][bin_index];
+      if (bin_index >= h.bands[band].size()) continue;
+      ++h.bands[band][bin_index];
+      const int segment =
+          std::min(kSegments - 1, static_cast<int>((p[1 - axis] + span) / (2.0 * span) * kSegments));
+      h.segments[band][bin_index] |= static_cast<std::uint8_t>(1u << segment);
     }
   }
   for (int w = 0; w < 4; ++w) {

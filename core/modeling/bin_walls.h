@@ -42,7 +42,9 @@ struct BinWalls {
 /// points): per wall, the points between 40 % and 90 % of the wall height, away from the corners,
 /// binned by their distance from the bin's centre line in 1 cm bins per height band; a face is the
 /// pair of adjacent bins that is the fullest in every one of four height bands (a tube lying at
-/// mid-height fills one band, a wall all of them) with at least min_points in each.
+/// mid-height fills one band, a wall all of them) with at least min_points in each, and whose
+/// points in each band spread over 6 of 8 segments along the wall (a tube standing against it fills
+/// one).
 BinWalls FindBinWalls(const Points& sample_Bin, const BinConfig& bin, const BinWallParams& params);
 
 /// "the −x wall at x = −0.400 m (the cell: −0.500 m), ...": every seen wall, misfits first.

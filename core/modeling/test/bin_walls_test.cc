@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/modeling/cloud_plausibility.h"
 
 namespace tubepick {
@@ -66,6 +68,12 @@ TEST(BinWalls, TubesAtMidHeightAreNoWallAndTooFewPointsNoEvidence) {
   Points tubes;
   for (double y = -0.25; y <= 0.25; y += 0.001) {
     for (double z = 0.09; z <= 0.115; z += 0.001) tubes.emplace_back(0.20f, y, z);  // a tube's side, one band
+  }
+  // And a tube standing upright 0.2 m from the centre, seen all round: it fills every band, but
+  // one segment along the wall, no face.
+  for (double a = 0.0; a < 6.28; a += 0.02) {
+    for (double z = 0.0; z <= 0.2; z += 0.001)
+      tubes.emplace_back(0.20 + 0.0125 * std::cos(a), 0.0125 * std::sin(a), z);
   }
   const BinWalls none = FindBinWalls(tubes, Bin(0.8, 0.6), BinWallParams{});
   EXPECT_TRUE(none.fit);
