@@ -87,6 +87,14 @@ std::string ToString(Held held) {
   return "unknown";
 }
 
+std::string DescribePlannerWarnings(const CellRunResult& result) {
+  if (result.planner_warnings.empty()) return "";
+  std::string text;
+  for (const auto& [code, scans] : result.planner_warnings)
+    text += fmt::format("{}{} in {} of {} scans", text.empty() ? "" : ", ", code, scans, result.scans);
+  return "; the planner warned: " + text + " (check the cell)";
+}
+
 std::string ToString(CellStopReason reason) {
   switch (reason) {
     case CellStopReason::kBinEmpty:
@@ -241,6 +249,8 @@ CellController::PlannedScan CellController::ScanBin(RunState& run) {
   const devices::Capture capture = Scan();
   scan.index = run.result.scans++;
   PlanPick(capture, scan);
+  for (const v1::ModelingWarning& w : scan.response.modeling().warnings())
+    ++run.result.planner_warnings[w.code()];
   return scan;
 }
 

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -108,7 +109,14 @@ struct CellRunResult {
   std::optional<std::string> operator_stop;
   /// Set when reason == kFault or kStopped: what the safe stop did with what the gripper held.
   std::optional<SafeStopOutcome> safe_stop;
+  /// Scans whose planner answer warned about the cell's inputs, per warning code
+  /// (ModelingWarning.code, e.g. "tube_length_shorter_than_scan").
+  std::map<std::string, std::uint32_t> planner_warnings;
 };
+
+/// "; the planner warned: tube_length_shorter_than_scan in 8 of 8 scans (check the cell)" for the
+/// round's line, or "" when no answer of the round warned.
+std::string DescribePlannerWarnings(const CellRunResult& result);
 
 /// What a command of a run does (PlannedMotion).
 enum class MotionKind {

@@ -161,6 +161,7 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_EQ(a["resolution"]["used"], 0);
   EXPECT_EQ(a["result"], "picked");
   EXPECT_FALSE(a.contains("planner_warnings"));
+  EXPECT_EQ(DescribePlannerWarnings(result), "");
   EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_Bin_grasp.x());
   EXPECT_GE(a["durations"]["planning_wall_s"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(a["durations"]["planning_server_s"].get<double>(), 0.5);
@@ -180,7 +181,14 @@ TEST_F(CellControllerTest, ThePlannersWarningsAboutTheCellAreInEveryAttemptRecor
   ft.readings = {Reading(0.10), Reading(0.64)};
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
-  EXPECT_EQ(Run().picks, 1u);
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u);
+  // The second scan (bin empty) came without the warning: 1 of the round's 2 scans.
+  EXPECT_EQ(result.scans, 2u);
+  EXPECT_EQ(result.planner_warnings,
+            (std::map<std::string, std::uint32_t>{{"tube_length_shorter_than_scan", 1}}));
+  EXPECT_EQ(DescribePlannerWarnings(result),
+            "; the planner warned: tube_length_shorter_than_scan in 1 of 2 scans (check the cell)");
   const std::vector<json> attempts = Records("attempt");
   ASSERT_EQ(attempts.size(), 1u);
   ASSERT_TRUE(attempts[0].contains("planner_warnings"));

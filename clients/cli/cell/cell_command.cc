@@ -171,6 +171,7 @@ json RoundJson(std::uint32_t round, const cell::CellRunResult& result, double wa
           {"lost_in_transit", result.lost},
           {"attempts", result.attempts},
           {"scans", result.scans},
+          {"planner_warnings", result.planner_warnings},
           {"wall_s", wall}};
 }
 
@@ -221,8 +222,9 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
       result = controller.Run(round);
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
-    fmt::print("round {:>2}: {} | {} picked, {} lost in transit, {} attempts, {} scans, {:.0f} s\n", round,
-               result.message, result.picks, result.lost, result.attempts, result.scans, wall);
+    fmt::print("round {:>2}: {} | {} picked, {} lost in transit, {} attempts, {} scans, {:.0f} s{}\n", round,
+               result.message, result.picks, result.lost, result.attempts, result.scans, wall,
+               cell::DescribePlannerWarnings(result));
     std::fflush(stdout);
     rounds_json.push_back(RoundJson(round, result, wall));
     if (result.reason != cell::CellStopReason::kBinEmpty &&
@@ -324,10 +326,10 @@ void Run(const CellOptions& o) {
     fmt::print(
         "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released "
         "outside, {}"
-        "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall\n",
+        "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall{}\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         r.tubes_unnoticed > 0 ? fmt::format("{} carried out unnoticed, ", r.tubes_unnoticed) : "",
-        result.attempts, result.scans, r.simulated_s, wall);
+        result.attempts, result.scans, r.simulated_s, wall, cell::DescribePlannerWarnings(result));
     std::fflush(stdout);
     json round_json = RoundJson(round, result, wall);
     round_json.update({{"seed", o.seed + round},
