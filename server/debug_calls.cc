@@ -78,16 +78,13 @@ std::string DebugCallStore::ListJson() const {
   bool first = true;
   for (const auto& call : Calls()) {
     const CallRecord& r = call->record;
-    std::string warnings;
-    for (const std::string& code : r.warnings)
-      warnings += fmt::format("{}\"{}\"", warnings.empty() ? "" : ",", JsonEscape(code));
     out += fmt::format(
         "{}{{\"id\":{},\"href\":\"/debug/calls/{}\",\"finished\":\"{}\",\"rpc\":\"{}\",\"code\":\"{}\","
         "\"message\":\"{}\",\"request_id\":\"{}\",\"points\":{},\"tubes\":{},\"plans\":{},\"total_ms\":{:.1f}"
-        ",\"warnings\":[{}],\"has_cloud\":{}}}",
+        ",\"warnings\":{},\"has_cloud\":{}}}",
         first ? "" : ",", call->id, call->id, UtcText(call->finished), JsonEscape(r.rpc), JsonEscape(r.code),
-        JsonEscape(r.message), JsonEscape(r.request_id), r.points, r.tubes, r.plans, r.total_ms, warnings,
-        call->capture && call->capture->frame.cloud ? "true" : "false");
+        JsonEscape(r.message), JsonEscape(r.request_id), r.points, r.tubes, r.plans, r.total_ms,
+        JsonStringArray(r.warnings), call->capture && call->capture->frame.cloud ? "true" : "false");
     first = false;
   }
   return out + "]";

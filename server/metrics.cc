@@ -81,12 +81,6 @@ void Metrics::RecordModelingWarning(std::string_view code) {
   ++it->second;
 }
 
-std::uint64_t Metrics::modeling_warnings(std::string_view code) const {
-  std::lock_guard lock(mu_);
-  auto it = modeling_warnings_.find(code);
-  return it == modeling_warnings_.end() ? 0 : it->second;
-}
-
 std::uint64_t Metrics::calls(std::string_view method, std::string_view code) const {
   std::lock_guard lock(mu_);
   auto it = calls_.find(std::pair<std::string, std::string>(method, code));

@@ -46,7 +46,6 @@ class Metrics {
 
   std::uint64_t calls(std::string_view method, std::string_view code) const;
   std::uint64_t rejected() const;
-  std::uint64_t modeling_warnings(std::string_view code) const;
 
   /// Every metric with HELP and TYPE lines; `load` gives the queue and worker gauges, `uploads`
   /// the PlanPickStream uploads in progress.

@@ -60,6 +60,13 @@ std::string JsonEscape(const std::string& text) {
   return out;
 }
 
+std::string JsonStringArray(const std::vector<std::string>& strings) {
+  std::string out = "[";
+  for (const std::string& s : strings)
+    out += fmt::format("{}\"{}\"", out.size() > 1 ? "," : "", JsonEscape(s));
+  return out + "]";
+}
+
 std::string FormatCallText(const CallRecord& r) {
   std::string out = fmt::format(
       "call rpc={} id={} peer={} code={} points={} tubes={} plans={} queue_ms={} run_ms={} "
@@ -79,12 +86,7 @@ std::string FormatCallJson(const CallRecord& r) {
       JsonEscape(r.rpc), JsonEscape(r.request_id), JsonEscape(r.peer), JsonEscape(r.code), r.points, r.tubes,
       r.plans, Ms(r.queue_ms), Ms(r.run_ms), Ms(r.total_ms));
   if (r.stop_ms) out += fmt::format(R"(,"stop_ms":{})", Ms(*r.stop_ms));
-  if (!r.warnings.empty()) {
-    out += R"(,"warnings":[)";
-    for (std::size_t i = 0; i < r.warnings.size(); ++i)
-      out += fmt::format(R"({}"{}")", i == 0 ? "" : ",", JsonEscape(r.warnings[i]));
-    out += ']';
-  }
+  if (!r.warnings.empty()) out += R"(,"warnings":)" + JsonStringArray(r.warnings);
   if (!r.message.empty()) out += fmt::format(R"(,"message":"{}")", JsonEscape(r.message));
   out += '}';
   return out;

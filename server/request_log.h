@@ -46,6 +46,8 @@ std::string FormatCallJson(const CallRecord& record);
 std::string UtcText(std::chrono::system_clock::time_point time);
 /// `text` with JSON string escaping, without the quotes.
 std::string JsonEscape(const std::string& text);
+/// `["a","b"]`: the strings escaped (JsonEscape), as a JSON array.
+std::string JsonStringArray(const std::vector<std::string>& strings);
 
 /// spdlog formatter writing one JSON object per line: {"time":"…Z","level":"info","msg":"…"}.
 /// A message that is itself a JSON object ({…}, as LogCall writes in JSON mode) is merged into the

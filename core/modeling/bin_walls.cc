@@ -94,18 +94,17 @@ BinWalls FindBinWalls(const Points& sample_Bin, const BinConfig& bin, const BinW
     const std::optional<double> out = FaceOf(histograms[w], params.min_points);
     if (!out) continue;
     walls.seen[w] = (w % 2 == 0 ? -1.0 : 1.0) * *out;
-    if (std::abs(*walls.seen[w] - walls.expected[w]) > params.tolerance) walls.fit = false;
+    walls.off[w] = std::abs(*walls.seen[w] - walls.expected[w]) > params.tolerance;
   }
   return walls;
 }
 
-std::string DescribeBinWalls(const BinWalls& walls, const BinWallParams& params) {
+std::string DescribeBinWalls(const BinWalls& walls) {
   std::string misfits, fits;
   for (int w = 0; w < 4; ++w) {
     if (!walls.seen[w]) continue;
     const char axis = w < 2 ? 'x' : 'y';
-    const bool off = std::abs(*walls.seen[w] - walls.expected[w]) > params.tolerance;
-    std::string& out = off ? misfits : fits;
+    std::string& out = walls.off[w] ? misfits : fits;
     out += fmt::format("{}the {} wall at {} = {:+.3f} m (the cell: {:+.3f} m)", out.empty() ? "" : ", ",
                        kWallNames[w], axis, *walls.seen[w], walls.expected[w]);
   }

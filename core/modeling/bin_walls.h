@@ -34,8 +34,11 @@ struct BinWalls {
   std::array<std::optional<double>, 4> seen;
   /// Per wall: where the cell puts it (±inner_size / 2).
   std::array<double, 4> expected{};
+  /// Per wall: seen more than the tolerance from where the cell puts it.
+  std::array<bool, 4> off{};
+
   /// Every seen wall within the tolerance of where the cell puts it.
-  bool fit = true;
+  bool fit() const { return off == std::array<bool, 4>{}; }
 };
 
 /// Finds the inner wall faces in `sample_Bin` (metres, bin frame; a sample of the cloud's finite
@@ -48,6 +51,6 @@ struct BinWalls {
 BinWalls FindBinWalls(const Points& sample_Bin, const BinConfig& bin, const BinWallParams& params);
 
 /// "the −x wall at x = −0.400 m (the cell: −0.500 m), ...": every seen wall, misfits first.
-std::string DescribeBinWalls(const BinWalls& walls, const BinWallParams& params);
+std::string DescribeBinWalls(const BinWalls& walls);
 
 }  // namespace tubepick

@@ -49,13 +49,10 @@ std::string Direction(const Eigen::Vector3d& v) {
 // is a shifted sensor pose; off in opposite ways, the bin's size.
 std::string DescribeMisfitWalls(const BinWalls& walls, const BinConfig& bin,
                                 const PlausibilityParams& params) {
-  BinWallParams wall_params;
-  wall_params.tolerance = params.wall_tolerance;
   bool shifted = false;
-  int inside = 0, outside = 0;  // seen walls nearer the centre than the cell's, and farther
+  int inside = 0, outside = 0;  // walls seen off nearer the centre than the cell's, and farther
   for (int w = 0; w < 4; ++w) {
-    if (!walls.seen[w] || std::abs(*walls.seen[w] - walls.expected[w]) <= params.wall_tolerance) continue;
-    (std::abs(*walls.seen[w]) < std::abs(walls.expected[w]) ? inside : outside) += 1;
+    if (walls.off[w]) (std::abs(*walls.seen[w]) < std::abs(walls.expected[w]) ? inside : outside) += 1;
   }
   for (int axis = 0; axis < 2; ++axis) {
     const auto& lo = walls.seen[2 * axis];
@@ -70,7 +67,7 @@ std::string DescribeMisfitWalls(const BinWalls& walls, const BinConfig& bin,
       "cloud does not fit the cell's bin: {} (more than {:g} m off). {} "
       "(modeling.plausibility.wall_tolerance; "
       "0 turns this check off)",
-      DescribeBinWalls(walls, wall_params), params.wall_tolerance,
+      DescribeBinWalls(walls), params.wall_tolerance,
       shifted
           ? "The walls are shifted, not resized: is the sensor pose right (sensor.pose_in_bin, X_BinSensor)?"
           : fmt::format("Is bin.inner_size [{:g}, {:g}, {:g}] m the bin's inner size, in metres? {}", s.x(),
@@ -165,7 +162,7 @@ CloudPlausibility CheckCloudAgainstCell(const Points& points_Bin, const BinConfi
 std::string DescribeImplausibleCloud(const CloudPlausibility& e, const BinConfig& bin, LengthUnit unit,
                                      const Eigen::Isometry3d& X_BinSensor, const PlausibilityParams& params) {
   const Eigen::Vector3d& s = bin.inner_size;
-  if (e.enough_inside && e.floor_seen && !e.walls.fit) return DescribeMisfitWalls(e.walls, bin, params);
+  if (e.enough_inside && e.floor_seen && !e.walls.fit()) return DescribeMisfitWalls(e.walls, bin, params);
   std::string text = fmt::format(
       "cloud does not fit the cell: {} of {} points ({:.1f} %) fall inside the bin volume "
       "(bin inner size {:g} × {:g} × {:g} m, {:g} m margin; at least {:.0f} % needed) and {} lie on "

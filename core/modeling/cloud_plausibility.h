@@ -60,7 +60,7 @@ struct CloudPlausibility {
   /// The inner wall faces the scan shows, against the cell's bin.
   BinWalls walls;
 
-  bool plausible() const { return enough_inside && floor_seen && walls.fit; }
+  bool plausible() const { return enough_inside && floor_seen && walls.fit(); }
 };
 
 /// The evidence of CheckCloudAgainstCell, gathered one point at a time, so that the pass that brings

@@ -64,31 +64,45 @@ Points UnfittedPoints(const Points& points,
   return out;
 }
 
+// The tubes of JoinModeledTubes, and how they were joined.
+struct JoinedTubes {
+  std::vector<Tube> tubes;
+  /// The whole tubes' length when the cell's tube.length is shorter than the scan shows.
+  std::optional<double> scan_length;
+  /// Joined as trees (junction joining), not as linear tubes.
+  bool trees = false;
+};
+
 // The cylinders joined into tubes: linear (JoinTubesOfLength) or, for a branched or `auto` cell,
-// chains joined within stricter limits first (JunctionParams::chain_max_distance), then into trees;
-// `auto` keeps the plain linear joining when the scene does not look branched. `scan_length`: the
-// whole tubes' length when the cell's tube.length is shorter than the scan shows.
-std::vector<Tube> JoinModeledTubes(const ModelingInput& input, const ModelingParams& params,
-                                   const std::vector<Cylinder>& cylinders, const Points& unfitted,
-                                   const RangeImage* seen, const StopToken* stop,
-                                   std::optional<double>* scan_length) {
-  if (input.topology == TubeTopology::kLinear) {
-    return JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop, scan_length);
+// chains joined within stricter limits first (JunctionParams::chain_max_distance), then into trees
+// with the rooms past their free ends (from the points no cylinder took); `auto` keeps the plain
+// linear joining when the scene does not look branched.
+JoinedTubes JoinModeledTubes(const ModelingInput& input, const ModelingParams& params,
+                             const std::vector<Cylinder>& cylinders, const Points& filtered,
+                             const std::vector<const std::vector<std::uint32_t>*>& inliers_of,
+                             const RangeImage* seen, const StopToken* stop) {
+  JoinedTubes out;
+  if (input.topology != TubeTopology::kLinear) {
+    JoiningParams chain_joining = params.joining;
+    chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
+    chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
+    const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
+    const EndRooms rooms =
+        MeasureEndRooms(UnfittedPoints(filtered, inliers_of), chains, params.junctions.end_room, seen);
+    JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop,
+                                                   rooms, input.tube_length, &out.scan_length);
+    out.trees = input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
+    spdlog::debug(
+        "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
+        joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
+        joined.tubes.size(), ToString(input.topology), out.trees ? "branched" : "linear");
+    if (out.trees) {
+      out.tubes = std::move(joined.tubes);
+      return out;
+    }
   }
-  JoiningParams chain_joining = params.joining;
-  chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
-  chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
-  const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
-  const EndRooms rooms = MeasureEndRooms(unfitted, chains, params.junctions.end_room, seen);
-  JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop, rooms,
-                                                 input.tube_length, scan_length);
-  const bool branched = input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
-  spdlog::debug(
-      "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
-      joined.junctions, joined.y_pieces, joined.completions, joined.chains_in_junctions, chains.size(),
-      joined.tubes.size(), ToString(input.topology), branched ? "branched" : "linear");
-  if (branched) return std::move(joined.tubes);
-  return JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop, scan_length);
+  out.tubes = JoinTubesOfLength(cylinders, params.joining, input.tube_length, seen, stop, &out.scan_length);
+  return out;
 }
 
 // The cell's tube radius must be one the cylinder fit can find: outside its radii every tube would
@@ -130,10 +144,10 @@ std::optional<ModelingWarning> TubeRadiusWarning(double tube_radius, const std::
 }
 
 // The cell's tube.length is shorter than the tubes the scan shows whole (`scan_length`, their
-// median length): joined within the scan's length instead, and said, with the likely cause.
+// median length; `trees`: joined as trees): joined within the scan's length instead, and said, with
+// the likely cause.
 ModelingWarning TubeLengthWarning(const ModelingInput& input, const ModelingParams& params,
-                                  double scan_length) {
-  const bool trees = input.topology != TubeTopology::kLinear;
+                                  double scan_length, bool trees) {
   const double share = trees ? params.junctions.max_length_share : params.joining.max_length_share;
   ModelingWarning w;
   w.code = "tube_length_shorter_than_scan";
@@ -322,10 +336,11 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   if (params.joining.visibility_check && !cloud.points.empty()) {
     visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
   }
-  std::optional<double> scan_length;
-  result.tubes = JoinModeledTubes(input, params, cylinders, UnfittedPoints(cloud.points, inliers_of),
-                                  visibility ? &*visibility : nullptr, stop, &scan_length);
-  if (scan_length) result.warnings.push_back(TubeLengthWarning(input, params, *scan_length));
+  JoinedTubes joined = JoinModeledTubes(input, params, cylinders, cloud.points, inliers_of,
+                                        visibility ? &*visibility : nullptr, stop);
+  result.tubes = std::move(joined.tubes);
+  if (joined.scan_length)
+    result.warnings.push_back(TubeLengthWarning(input, params, *joined.scan_length, joined.trees));
   result.tube_of_point = TubeOfPoint(result.tubes, cylinders, inliers_of, cloud.size());
   result.timings.push_back({"joining", SecondsSince(t0)});
 

@@ -39,7 +39,7 @@ BinConfig Bin(double L, double W, double H = 0.2) {
 
 TEST(BinWalls, TheFacesOfTheCellsBinAreSeenWhereItPutsThem) {
   const BinWalls walls = FindBinWalls(BinSurfaces(0.8, 0.6, 0.2), Bin(0.8, 0.6), BinWallParams{});
-  EXPECT_TRUE(walls.fit);
+  EXPECT_TRUE(walls.fit());
   const double expected[] = {-0.40, 0.40, -0.30, 0.30};
   for (int w = 0; w < 4; ++w) {
     ASSERT_TRUE(walls.seen[w].has_value()) << kWallNames[w];
@@ -51,16 +51,16 @@ TEST(BinWalls, TheFacesOfTheCellsBinAreSeenWhereItPutsThem) {
 TEST(BinWalls, ABinSetLargerOrSmallerThanTheScannedOneDoesNotFit) {
   const Points scan = BinSurfaces(0.8, 0.6, 0.2);
   const BinWalls larger = FindBinWalls(scan, Bin(1.0, 0.8), BinWallParams{});
-  EXPECT_FALSE(larger.fit);
+  EXPECT_FALSE(larger.fit());
   ASSERT_TRUE(larger.seen[1].has_value());
   EXPECT_NEAR(*larger.seen[1], 0.40, 0.011);
-  EXPECT_THAT(DescribeBinWalls(larger, BinWallParams{}),
+  EXPECT_THAT(DescribeBinWalls(larger),
               ::testing::HasSubstr("the +x wall at x = +0.400 m (the cell: +0.500 m)"));
-  EXPECT_FALSE(FindBinWalls(scan, Bin(0.7, 0.6), BinWallParams{}).fit);  // the x walls 5 cm beyond
-  EXPECT_TRUE(FindBinWalls(scan, Bin(0.86, 0.6), BinWallParams{}).fit);  // 3 cm: within 4 cm
+  EXPECT_FALSE(FindBinWalls(scan, Bin(0.7, 0.6), BinWallParams{}).fit());  // the x walls 5 cm beyond
+  EXPECT_TRUE(FindBinWalls(scan, Bin(0.86, 0.6), BinWallParams{}).fit());  // 3 cm: within 4 cm
   BinWallParams off;
   off.tolerance = 0.0;
-  EXPECT_TRUE(FindBinWalls(scan, Bin(1.0, 0.8), off).fit);
+  EXPECT_TRUE(FindBinWalls(scan, Bin(1.0, 0.8), off).fit());
 }
 
 TEST(BinWalls, TubesAtMidHeightAreNoWallAndTooFewPointsNoEvidence) {
@@ -76,11 +76,11 @@ TEST(BinWalls, TubesAtMidHeightAreNoWallAndTooFewPointsNoEvidence) {
       tubes.emplace_back(0.20 + 0.0125 * std::cos(a), 0.0125 * std::sin(a), z);
   }
   const BinWalls none = FindBinWalls(tubes, Bin(0.8, 0.6), BinWallParams{});
-  EXPECT_TRUE(none.fit);
+  EXPECT_TRUE(none.fit());
   for (const auto& seen : none.seen) EXPECT_FALSE(seen.has_value());
   // The walls at a coarse grid: too few points per band to be sure of anything.
   const BinWalls sparse = FindBinWalls(BinSurfaces(0.8, 0.6, 0.2, 0.05), Bin(1.0, 0.8), BinWallParams{});
-  EXPECT_TRUE(sparse.fit);
+  EXPECT_TRUE(sparse.fit());
 }
 
 TEST(CloudPlausibility, AScanWhoseWallsAreNotTheCellsIsNotPlausibleAndSaysWhich) {
