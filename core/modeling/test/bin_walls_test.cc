@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/common/errors.h"
 #include "core/modeling/cloud_plausibility.h"
 
 namespace tubepick {
@@ -109,6 +110,13 @@ TEST(CloudPlausibility, AScanWhoseWallsAreNotTheCellsIsNotPlausibleAndSaysWhich)
       ::testing::HasSubstr("The walls are shifted, not resized: is the sensor pose right"));
   params.wall_tolerance = 0.0;
   EXPECT_TRUE(CheckCloudAgainstCell(scan, larger, params).plausible());
+  params.wall_tolerance = -0.01;
+  try {
+    params.Validate();
+    FAIL() << "a negative wall tolerance was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("modeling.plausibility.wall_tolerance"));
+  }
 }
 
 }  // namespace

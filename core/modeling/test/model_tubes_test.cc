@@ -175,6 +175,12 @@ TEST(ModelTubes, ATubeLengthShorterThanTheScanShowsIsNotBelieved) {
   EXPECT_NEAR(w.observed, 0.40, 0.02);
   EXPECT_NE(w.message.find("tube.length 0.300 m"), std::string::npos) << w.message;
   EXPECT_EQ(r.tubes.size(), 5u);
+  // A cell of topology `auto` whose scene is linear: the same warning, about linear tubes.
+  input.topology = TubeTopology::kAuto;
+  const ModelingResult a = ModelTubes(input, params);
+  ASSERT_EQ(a.warnings.size(), 1u);
+  EXPECT_THAT(a.warnings[0].message, ::testing::HasSubstr("the tubes this scan shows"));
+  EXPECT_THAT(a.warnings[0].message, ::testing::HasSubstr("the parts' whole curve length"));
 }
 
 TEST(ModelTubes, ACellRadiusTheFitCannotFindIsRefusedNamingBothRanges) {
