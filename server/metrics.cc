@@ -1,5 +1,6 @@
 #include "server/metrics.h"
 
+#include <dlfcn.h>
 #include <fmt/format.h>
 
 #include <fstream>
@@ -38,6 +39,27 @@ std::optional<ProcessMemory> ReadProcessMemory() {
   }
   if (!rss || !hwm) return std::nullopt;
   return memory;
+}
+
+std::optional<AllocatorMemory> ReadAllocatorMemory() {
+  // jemalloc's mallctl, looked up at run time: the library does not link jemalloc, tubepick-server does.
+  using Mallctl = int (*)(const char*, void*, std::size_t*, void*, std::size_t);
+  static const auto mallctl = reinterpret_cast<Mallctl>(::dlsym(RTLD_DEFAULT, "mallctl"));
+  if (mallctl == nullptr) return std::nullopt;
+  // The statistics are a snapshot taken when the epoch advances.
+  std::uint64_t epoch = 1;
+  std::size_t epoch_size = sizeof(epoch);
+  if (mallctl("epoch", &epoch, &epoch_size, &epoch, epoch_size) != 0) return std::nullopt;
+  const auto read = [](const char* name) -> std::optional<std::uint64_t> {
+    std::size_t value = 0;
+    std::size_t size = sizeof(value);
+    if (mallctl(name, &value, &size, nullptr, 0) != 0) return std::nullopt;
+    return value;
+  };
+  const std::optional<std::uint64_t> allocated = read("stats.allocated");
+  const std::optional<std::uint64_t> resident = read("stats.resident");
+  if (!allocated || !resident) return std::nullopt;
+  return AllocatorMemory{*allocated, *resident};
 }
 
 Metrics::Metrics() {
@@ -141,6 +163,18 @@ std::string Metrics::RenderPrometheus(const PoolLoad& load, std::uint32_t upload
     fmt::format_to(o, "process_resident_memory_bytes {}\n", memory->resident_bytes);
     header("process_resident_memory_peak_bytes", "gauge", "Peak resident memory size in bytes (VmHWM).");
     fmt::format_to(o, "process_resident_memory_peak_bytes {}\n", memory->peak_resident_bytes);
+  }
+  if (const std::optional<AllocatorMemory> heap = ReadAllocatorMemory()) {
+    header(
+        "tubepick_allocator_allocated_bytes", "gauge",
+        "Bytes in live allocations (jemalloc stats.allocated): grows with a leak, not with the allocator's "
+        "cache.");
+    fmt::format_to(o, "tubepick_allocator_allocated_bytes {}\n", heap->allocated);
+    header("tubepick_allocator_resident_bytes", "gauge",
+           "Bytes of the allocator's resident pages (jemalloc stats.resident): live allocations plus freed "
+           "pages "
+           "kept for reuse until unused for ~10 s.");
+    fmt::format_to(o, "tubepick_allocator_resident_bytes {}\n", heap->resident);
   }
   return out;
 }

@@ -23,8 +23,10 @@ struct LoadCommandOptions {
   std::uint64_t seed = 0;
   std::size_t chunk_kib = 1024;
   bool fail_on_error = false;
-  /// Fail when the server's median RSS grows more than this, percent; unset = no memory check.
+  /// Fail when the server's mean RSS grows more than this, percent; unset = no memory check.
   std::optional<double> max_rss_growth;
+  /// Fail when the server's mean live bytes (the allocator's) grow more than this, percent; unset = no check.
+  std::optional<double> max_allocated_growth;
 };
 
 v1::LengthUnit ProtoUnit(const std::string& unit) {
@@ -53,11 +55,17 @@ void Run(LoadCommandOptions& o, bool seed_given) {
     fmt::print(stderr, "load: {} of {} calls failed\n", report.total - report.ok, report.total);
     failed = true;
   }
+  // Half the scrapes a window should hold, at least 3: fewer means the endpoint was not answering.
+  const auto min_samples = static_cast<std::size_t>(
+      std::max(3.0, std::floor(0.5 * o.load.rss_window_seconds / o.load.metrics_interval_seconds)));
   if (o.max_rss_growth && report.rss) {
-    // Half the scrapes a window should hold, at least 3: fewer means the endpoint was not answering.
-    const auto min_samples = static_cast<std::size_t>(
-        std::max(3.0, std::floor(0.5 * o.load.rss_window_seconds / o.load.metrics_interval_seconds)));
     if (const auto failure = RssGrowthFailure(*report.rss, *o.max_rss_growth, min_samples)) {
+      fmt::print(stderr, "load: {}\n", *failure);
+      failed = true;
+    }
+  }
+  if (o.max_allocated_growth && report.rss) {
+    if (const auto failure = AllocatedGrowthFailure(*report.rss, *o.max_allocated_growth, min_samples)) {
       fmt::print(stderr, "load: {}\n", *failure);
       failed = true;
     }
@@ -127,9 +135,21 @@ void AddLoadCommand(CLI::App& app) {
                   "Length of the first and last windows of the run whose RSS samples are compared, seconds")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option("--rss-settle", o->load.rss_settle_seconds,
+                  "Begin the first RSS window this long after sampling starts, seconds (the allocator's "
+                  "memory climbs for a while under fresh load)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--max-rss-growth", o->max_rss_growth,
                   "Exit 1 when the mean RSS of the last window exceeds that of the first by more than this, "
                   "percent (needs --metrics-url)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(metrics_url);
+  cmd->add_option(
+         "--max-allocated-growth", o->max_allocated_growth,
+         "Exit 1 when the server's mean live bytes (tubepick_allocator_allocated_bytes) of the last window "
+         "exceed those of the first by more than this, percent, or it does not export them (needs "
+         "--metrics-url)")
       ->check(CLI::NonNegativeNumber)
       ->needs(metrics_url);
   cmd->add_option("--connect-timeout", o->load.connect_timeout_seconds,

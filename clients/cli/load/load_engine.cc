@@ -394,7 +394,8 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   });
   if (phase.sampler)
     report.rss = phase.sampler->Stop(o.rss_window_seconds,
-                                     o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt);
+                                     o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt,
+                                     o.rss_settle_seconds);
   return report;
 }
 
@@ -446,17 +447,27 @@ std::string FormatLoadReportText(const LoadReport& r) {
     if (m.samples.empty()) {
       line("  no sample");
     } else {
-      line(fmt::format("  first {:.0f} s max {}, last {:.0f} s max {} ({:+.1f} %), peak {}", m.window_seconds,
-                       HumanBytes(static_cast<double>(m.first_window_max)), m.window_seconds,
+      // The windows as times since sampling began, e.g. "[30, 60] s".
+      const double first_begin = m.samples.front().seconds + m.settle_seconds;
+      const std::string first =
+          fmt::format("[{:.0f}, {:.0f}] s", first_begin, first_begin + m.window_seconds);
+      const std::string last =
+          fmt::format("[{:.0f}, {:.0f}] s", m.end_seconds - m.window_seconds, m.end_seconds);
+      line(fmt::format("  first {} max {}, last {} max {} ({:+.1f} %), peak {}", first,
+                       HumanBytes(static_cast<double>(m.first_window_max)), last,
                        HumanBytes(static_cast<double>(m.last_window_max)), m.growth_percent,
                        HumanBytes(static_cast<double>(m.peak))));
-      line(fmt::format("  first {:.0f} s mean {}, last {:.0f} s mean {} ({:+.1f} %); {} and {} samples",
-                       m.window_seconds, HumanBytes(m.first_window_mean), m.window_seconds,
-                       HumanBytes(m.last_window_mean), m.mean_growth_percent, m.first_window_samples,
-                       m.last_window_samples));
-      line(fmt::format("  first {:.0f} s median {}, last {:.0f} s median {} ({:+.1f} %)", m.window_seconds,
-                       HumanBytes(static_cast<double>(m.first_window_median)), m.window_seconds,
+      line(fmt::format("  first {} mean {}, last {} mean {} ({:+.1f} %); {} and {} samples", first,
+                       HumanBytes(m.first_window_mean), last, HumanBytes(m.last_window_mean),
+                       m.mean_growth_percent, m.first_window_samples, m.last_window_samples));
+      line(fmt::format("  first {} median {}, last {} median {} ({:+.1f} %)", first,
+                       HumanBytes(static_cast<double>(m.first_window_median)), last,
                        HumanBytes(static_cast<double>(m.last_window_median)), m.median_growth_percent));
+      if (m.first_window_allocated_mean > 0.0)
+        line(fmt::format(
+            "  first {} allocated {}, last {} allocated {} ({:+.1f} %) (the allocator's live bytes)", first,
+            HumanBytes(m.first_window_allocated_mean), last, HumanBytes(m.last_window_allocated_mean),
+            m.allocated_growth_percent));
     }
   }
   return out;
@@ -502,10 +513,15 @@ std::string FormatLoadReportJson(const LoadReport& r) {
   if (r.rss) {
     const RssSummary& m = *r.rss;
     nlohmann::json samples = nlohmann::json::array();
-    for (const RssSample& s : m.samples) samples.push_back({{"seconds", s.seconds}, {"bytes", s.bytes}});
+    for (const RssSample& s : m.samples) {
+      nlohmann::json sample = {{"seconds", s.seconds}, {"bytes", s.bytes}};
+      if (s.allocated_bytes > 0) sample["allocated_bytes"] = s.allocated_bytes;
+      samples.push_back(std::move(sample));
+    }
     j["server_rss"] = {{"url", m.url},
                        {"interval_seconds", m.interval_seconds},
                        {"window_seconds", m.window_seconds},
+                       {"settle_seconds", m.settle_seconds},
                        {"first_window_max_bytes", m.first_window_max},
                        {"last_window_max_bytes", m.last_window_max},
                        {"peak_bytes", m.peak},
@@ -519,6 +535,9 @@ std::string FormatLoadReportJson(const LoadReport& r) {
                        {"first_window_median_bytes", m.first_window_median},
                        {"last_window_median_bytes", m.last_window_median},
                        {"median_growth_percent", m.median_growth_percent},
+                       {"first_window_allocated_mean_bytes", m.first_window_allocated_mean},
+                       {"last_window_allocated_mean_bytes", m.last_window_allocated_mean},
+                       {"allocated_growth_percent", m.allocated_growth_percent},
                        {"failed_scrapes", m.failed_scrapes},
                        {"samples", samples}};
   }

@@ -74,6 +74,8 @@ struct LoadOptions {
   double metrics_interval_seconds = 5.0;
   /// Length of the first and last windows the RSS samples are compared over, seconds.
   double rss_window_seconds = 60.0;
+  /// How long after sampling starts the first window begins, seconds (RssSummary::settle_seconds).
+  double rss_settle_seconds = 0.0;
   /// How long to wait for the channel to connect before giving up, seconds.
   double connect_timeout_seconds = 10.0;
 };

@@ -85,23 +85,32 @@ std::optional<double> PrometheusSample(std::string_view text, std::string_view n
 }
 
 RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
-                        std::optional<double> end_seconds) {
+                        std::optional<double> end_seconds, double settle_seconds) {
   RssSummary s;
   s.window_seconds = window_seconds;
+  s.settle_seconds = settle_seconds;
   s.samples = std::move(samples);
   if (s.samples.empty()) {
     s.end_seconds = end_seconds.value_or(0.0);
     return s;
   }
-  const double begin = s.samples.front().seconds;
+  const double begin = s.samples.front().seconds + settle_seconds;
   const double end = end_seconds.value_or(s.samples.back().seconds);
   s.end_seconds = end;
   std::vector<std::uint64_t> first;
   std::vector<std::uint64_t> last;
+  std::vector<std::uint64_t> first_allocated;
+  std::vector<std::uint64_t> last_allocated;
   for (const RssSample& r : s.samples) {
     s.peak = std::max(s.peak, r.bytes);
-    if (r.seconds <= begin + window_seconds) first.push_back(r.bytes);
-    if (r.seconds >= end - window_seconds && r.seconds <= end) last.push_back(r.bytes);
+    if (r.seconds >= begin && r.seconds <= begin + window_seconds) {
+      first.push_back(r.bytes);
+      first_allocated.push_back(r.allocated_bytes);
+    }
+    if (r.seconds >= end - window_seconds && r.seconds <= end) {
+      last.push_back(r.bytes);
+      last_allocated.push_back(r.allocated_bytes);
+    }
   }
   const auto percent = [](std::uint64_t from, std::uint64_t to) {
     return from == 0
@@ -132,6 +141,15 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
   s.last_window_median = median(last);
   s.growth_percent = percent(s.first_window_max, s.last_window_max);
   s.median_growth_percent = percent(s.first_window_median, s.last_window_median);
+  const auto all_have = [](const std::vector<std::uint64_t>& v) {
+    return !v.empty() && std::find(v.begin(), v.end(), 0u) == v.end();
+  };
+  if (all_have(first_allocated) && all_have(last_allocated)) {
+    s.first_window_allocated_mean = mean(first_allocated);
+    s.last_window_allocated_mean = mean(last_allocated);
+    s.allocated_growth_percent = 100.0 * (s.last_window_allocated_mean - s.first_window_allocated_mean) /
+                                 s.first_window_allocated_mean;
+  }
   return s;
 }
 
@@ -147,10 +165,29 @@ std::optional<std::string> RssGrowthFailure(const RssSummary& s, double max_grow
   if (s.mean_growth_percent > max_growth_percent)
     return fmt::format(
         "server RSS grew {:+.1f} % (mean of the last {:.0f} s {:.1f} MB against {:.1f} MB in the first "
-        "{:.0f} s), "
-        "more than the {:.1f} % allowed",
+        "{:.0f} s after {:.0f} s of settling), more than the {:.1f} % allowed",
         s.mean_growth_percent, s.window_seconds, s.last_window_mean / 1e6, s.first_window_mean / 1e6,
-        s.window_seconds, max_growth_percent);
+        s.window_seconds, s.settle_seconds, max_growth_percent);
+  return std::nullopt;
+}
+
+std::optional<std::string> AllocatedGrowthFailure(const RssSummary& s, double max_growth_percent,
+                                                  std::size_t min_window_samples) {
+  if (s.first_window_samples < min_window_samples || s.last_window_samples < min_window_samples)
+    return RssGrowthFailure(s, max_growth_percent, min_window_samples);
+  if (s.first_window_allocated_mean <= 0.0 || s.last_window_allocated_mean <= 0.0)
+    return std::string(
+        "the server exported no tubepick_allocator_allocated_bytes in every scrape of both windows (a server "
+        "without jemalloc, e.g. a sanitizer build): its live bytes cannot be judged");
+  if (s.allocated_growth_percent > max_growth_percent)
+    return fmt::format(
+        "the server's live bytes grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean of the last {:.0f} "
+        "s "
+        "{:.1f} MB against {:.1f} MB in the first {:.0f} s after {:.0f} s of settling), more than the {:.1f} "
+        "% "
+        "allowed: a leak",
+        s.allocated_growth_percent, s.window_seconds, s.last_window_allocated_mean / 1e6,
+        s.first_window_allocated_mean / 1e6, s.window_seconds, s.settle_seconds, max_growth_percent);
   return std::nullopt;
 }
 
@@ -169,13 +206,17 @@ RssSampler::~RssSampler() {
 void RssSampler::SampleOnce() {
   const double t = std::chrono::duration<double>(Clock::now() - start_).count();
   std::optional<double> bytes;
+  std::optional<double> allocated;
   try {
-    bytes = PrometheusSample(HttpGet(url_, std::chrono::seconds(5)), "process_resident_memory_bytes");
+    const std::string text = HttpGet(url_, std::chrono::seconds(5));
+    bytes = PrometheusSample(text, "process_resident_memory_bytes");
+    allocated = PrometheusSample(text, "tubepick_allocator_allocated_bytes");
   } catch (const std::exception&) {
   }
   std::lock_guard lock(mutex_);
   if (bytes && *bytes >= 0)
-    samples_.push_back({t, static_cast<std::uint64_t>(*bytes)});
+    samples_.push_back({t, static_cast<std::uint64_t>(*bytes),
+                        allocated && *allocated > 0 ? static_cast<std::uint64_t>(*allocated) : 0});
   else
     ++failed_;
 }
@@ -188,7 +229,7 @@ void RssSampler::Loop() {
   }
 }
 
-RssSummary RssSampler::Stop(double window_seconds, std::optional<double> end_seconds) {
+RssSummary RssSampler::Stop(double window_seconds, std::optional<double> end_seconds, double settle_seconds) {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
@@ -197,7 +238,7 @@ RssSummary RssSampler::Stop(double window_seconds, std::optional<double> end_sec
   if (thread_.joinable()) thread_.join();
   SampleOnce();
   std::lock_guard lock(mutex_);
-  RssSummary summary = SummarizeRss(samples_, window_seconds, end_seconds);
+  RssSummary summary = SummarizeRss(samples_, window_seconds, end_seconds, settle_seconds);
   summary.url = url_;
   summary.interval_seconds = std::chrono::duration<double>(interval_).count();
   summary.failed_scrapes = failed_;

@@ -75,6 +75,64 @@ TEST(LoadMetrics, SummarizeRssOverWindowsEndingAtTheMeasuredPhase) {
   EXPECT_EQ(to_last.last_window_max, 5'000'000'000u);
 }
 
+TEST(LoadMetrics, TheFirstWindowBeginsAfterTheSettlingTime) {
+  // A freshly loaded server's RSS climbs from 200 to 600 MB over its first 10 s (the allocator keeps
+  // freed pages for ~10 s) and then stays at 600 MB: no leak. Compared from the first sample, the climb
+  // reads as growth; compared after 30 s of settling, it does not.
+  std::vector<RssSample> samples;
+  for (int t = 0; t <= 120; ++t)
+    samples.push_back(
+        {static_cast<double>(t), static_cast<std::uint64_t>(std::min(t, 10) * 40 + 200) * 1'000'000});
+  const RssSummary from_start = SummarizeRss(samples, 30.0, 120.0);
+  EXPECT_GT(from_start.mean_growth_percent, 10.0);
+  EXPECT_TRUE(RssGrowthFailure(from_start, 10.0, 15).has_value());
+
+  const RssSummary settled = SummarizeRss(samples, 30.0, 120.0, 30.0);
+  EXPECT_EQ(settled.settle_seconds, 30.0);
+  EXPECT_EQ(settled.first_window_samples, 31u);  // t = 30 .. 60
+  EXPECT_EQ(settled.first_window_mean, 600e6);
+  EXPECT_EQ(settled.mean_growth_percent, 0.0);
+  EXPECT_FALSE(RssGrowthFailure(settled, 10.0, 15).has_value());
+
+  // A leak of 2 MB a second after the climb (+18 % between the windows) still fails, and the message says how
+  // long it settled.
+  for (RssSample& r : samples)
+    if (r.seconds > 10.0) r.bytes += static_cast<std::uint64_t>(r.seconds - 10.0) * 2'000'000;
+  const std::optional<std::string> leak =
+      RssGrowthFailure(SummarizeRss(samples, 30.0, 120.0, 30.0), 10.0, 15);
+  ASSERT_TRUE(leak.has_value());
+  EXPECT_NE(leak->find("after 30 s of settling"), std::string::npos) << *leak;
+}
+
+TEST(LoadMetrics, TheAllocatorsLiveBytesAreComparedWhenEverySampleHasThem) {
+  // RSS flat at 500 MB while the live bytes grow from 200 to 260 MB: a leak the allocator's cache hides.
+  std::vector<RssSample> samples;
+  for (int t = 0; t <= 120; ++t)
+    samples.push_back(
+        {static_cast<double>(t), 500'000'000u, static_cast<std::uint64_t>(200 + t / 2) * 1'000'000});
+  const RssSummary s = SummarizeRss(samples, 30.0, 120.0);
+  EXPECT_EQ(s.mean_growth_percent, 0.0);
+  EXPECT_NEAR(s.first_window_allocated_mean, 207.25e6, 0.5e6);  // 200 + t/2 over t = 0 .. 30, rounded down
+  EXPECT_NEAR(s.last_window_allocated_mean, 252.25e6, 0.5e6);
+  EXPECT_NEAR(s.allocated_growth_percent, 100.0 * 45.0 / 207.25, 0.5);
+
+  const std::optional<std::string> leak = AllocatedGrowthFailure(s, 10.0, 15);
+  ASSERT_TRUE(leak.has_value());
+  EXPECT_NE(leak->find("live bytes grew +21.7 %"), std::string::npos) << *leak;
+  EXPECT_FALSE(AllocatedGrowthFailure(s, 25.0, 15).has_value());
+  EXPECT_FALSE(RssGrowthFailure(s, 10.0, 15).has_value());  // the RSS alone would not see it
+
+  // A server that does not export them (0 in any sample of a window): nothing to compare, and the check
+  // says so rather than passing.
+  samples[100].allocated_bytes = 0;
+  const RssSummary partial = SummarizeRss(samples, 30.0, 120.0);
+  EXPECT_EQ(partial.first_window_allocated_mean, 0.0);
+  EXPECT_EQ(partial.allocated_growth_percent, 0.0);
+  const std::optional<std::string> unknown = AllocatedGrowthFailure(partial, 10.0, 15);
+  ASSERT_TRUE(unknown.has_value());
+  EXPECT_NE(unknown->find("exported no tubepick_allocator_allocated_bytes"), std::string::npos) << *unknown;
+}
+
 TEST(LoadMetrics, MedianIsTheNearestRank) {
   // Four samples in the window: the nearest-rank median is the 2nd smallest.
   const RssSummary s = SummarizeRss({{0, 40}, {1, 10}, {2, 30}, {3, 20}}, 10.0);
