@@ -88,6 +88,22 @@ TEST(CellCliTest, FaultCampaignNeverReleasesATubeOutsideTheBinOrThePlaceZone) {
   EXPECT_EQ(elsewhere, 0);
 }
 
+TEST(CellCliTest, TubesHeavierThanTheCellSaysAreNamedInTheRoundLine) {
+  // The simulated PVC tubes weigh 0.080 kg where the cell says 0.055 kg: each lift weighs about 1.45
+  // tubes, and the round's line and JSON say the lifts doubt tube.mass.
+  const auto dir = testing::TempDir("cell_mass");
+  const auto json_path = dir / "cell.json";
+  const testing::CliRun run =
+      RunCli("cell --sim --rounds 1 --tubes 3 --seed 1 --sim-tube-mass 0.08 --json " + json_path.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("the lifts doubt tube.mass after"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("times tube.mass (0.055 kg)"), std::string::npos) << run.output;
+  const nlohmann::json j = testing::ReadJson(json_path);
+  EXPECT_GE(j["rounds"][0]["tube_mass_doubts"].get<int>(), 1);
+  EXPECT_NE(j["rounds"][0]["tube_mass_doubt"].get<std::string>().find("is tube.mass right?"),
+            std::string::npos);
+}
+
 TEST(CellCliTest, InjectedFaultRateOutsideZeroToOneIsRefused) {
   const testing::CliRun run = RunCli("cell --sim --rounds 1 --inject-faults 5");
   EXPECT_EQ(run.exit_code, 2) << run.output;

@@ -14,6 +14,7 @@
 #include "clients/cell/local_wrench_analysis.h"
 #include "clients/cell/tool_clearance.h"
 #include "core/wrench/resolution_hold.h"
+#include "core/wrench/tube_mass_check.h"
 #include "wire/proto_convert.h"
 
 namespace tubepick::cell {
@@ -194,7 +195,30 @@ v1::AnalyzeWrenchResponse CellController::AnalyzeLift(const devices::WrenchReadi
   const v1::AnalyzeWrenchResponse analysis = Analyze(reference, *lifted, X_BinTcpLift, attempt);
   record["analysis"] = AnalysisJson(analysis);
   record["resolution"] = ResolutionJson(analysis.resolution_motions_size());
+  CheckLiftWeights(analysis.tube_ratio(), attempt);
   return analysis;
+}
+
+/// Whether the cell's recent lifts still fit tube.mass (CheckTubeMass): the doubt goes into the attempt's
+/// record and, the first time, the log. Algorithm 3's decision stands either way.
+void CellController::CheckLiftWeights(double tube_ratio, Attempt& attempt) {
+  constexpr std::size_t kKept = 64;
+  lift_ratios_.push_back(tube_ratio);
+  if (lift_ratios_.size() > kKept) lift_ratios_.erase(lift_ratios_.begin());
+  const std::optional<TubeMassDoubt> doubt = CheckTubeMass(lift_ratios_, cell_.tube.mass);
+  if (!doubt) return;
+  attempt.record["tube_mass_doubt"] = {{"message", doubt->message},
+                                       {"lifts", doubt->lifts},
+                                       {"min_ratio", doubt->min_ratio},
+                                       {"max_ratio", doubt->max_ratio},
+                                       {"median_ratio", doubt->median_ratio},
+                                       {"tube_mass", doubt->tube_mass},
+                                       {"mass_if_single", doubt->mass_if_single}};
+  attempt.tube_mass_doubt = doubt->message;
+  spdlog::log(tube_mass_doubt_said_ ? spdlog::level::debug : spdlog::level::warn, "cell: round {}: {}{}",
+              round_, doubt->message,
+              tube_mass_doubt_said_ ? "" : " (said once; the attempt records carry it as tube_mass_doubt)");
+  tube_mass_doubt_said_ = true;
 }
 
 std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOutcome outcome,

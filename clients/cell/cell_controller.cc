@@ -95,6 +95,12 @@ std::string DescribePlannerWarnings(const CellRunResult& result) {
   return "; the planner warned: " + text + " (check the cell)";
 }
 
+std::string DescribeTubeMassDoubt(const CellRunResult& result) {
+  if (result.tube_mass_doubts == 0) return "";
+  return fmt::format("; the lifts doubt tube.mass after {} of {} attempts: {}", result.tube_mass_doubts,
+                     result.attempts, result.tube_mass_doubt);
+}
+
 std::string ToString(CellStopReason reason) {
   switch (reason) {
     case CellStopReason::kBinEmpty:
@@ -339,13 +345,21 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   d["attempt_wall_s"] = SecondsSince(attempt.started);
   d["attempt_device_s"] = DeviceNow() - attempt.device_started;
   record["truth_after"] = Truth();
-  run.result.local_analyses += attempt.local_analyses;
+  CountAttemptWrench(attempt, run.result);
   if (sink_) sink_->Write(record);
   spdlog::info("cell: round {} attempt {}: tube {} {} -> {}", round_, run.result.attempts,
                record.value("tube", 0u), record.value("trajectory_kind", ""),
                record["result"].get<std::string>());
   run.active.reset();
   return outcome;
+}
+
+void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& result) {
+  result.local_analyses += attempt.local_analyses;
+  if (attempt.tube_mass_doubt) {
+    ++result.tube_mass_doubts;
+    result.tube_mass_doubt = *attempt.tube_mass_doubt;
+  }
 }
 
 bool CellController::CountAttempt(AttemptResult outcome, RunState& run) {
@@ -441,7 +455,7 @@ nlohmann::json CellController::Nudge(const NudgePlan& nudge, nlohmann::json reco
 
 void CellController::RecordInterruptedAttempt(RunState& run, const StopCause& cause) {
   if (!run.active) return;
-  run.result.local_analyses += run.active->local_analyses;
+  CountAttemptWrench(*run.active, run.result);
   nlohmann::json& record = run.active->record;
   // A tube already placed when the fault (or the stop) came, on the way home, is a pick, with the
   // fault beside it.

@@ -112,11 +112,19 @@ struct CellRunResult {
   /// Scans whose planner answer warned about the cell's inputs, per warning code
   /// (ModelingWarning.code, e.g. "tube_length_shorter_than_scan").
   std::map<std::string, std::uint32_t> planner_warnings;
+  /// Attempts after whose lift the cell's recent lifts weighed no whole number of tubes against
+  /// tube.mass (CheckTubeMass), and the last such doubt ("" when none).
+  std::uint32_t tube_mass_doubts = 0;
+  std::string tube_mass_doubt;
 };
 
 /// "; the planner warned: tube_length_shorter_than_scan in 8 of 8 scans (check the cell)" for the
 /// round's line, or "" when no answer of the round warned.
 std::string DescribePlannerWarnings(const CellRunResult& result);
+
+/// "; the lifts doubt tube.mass after 4 of 6 attempts: <the last doubt>" for the round's line, or ""
+/// when no lift of the round did.
+std::string DescribeTubeMassDoubt(const CellRunResult& result);
 
 /// What a command of a run does (PlannedMotion).
 enum class MotionKind {
@@ -322,6 +330,8 @@ class CellController {
   AttemptResult PickAttempt(PlannedScan& scan, int rank, bool first_of_scan, RunState& run);
   Attempt& BeginAttempt(PlannedScan& scan, int rank, bool first_of_scan, RunState& run);
   AttemptResult FinishAttempt(RunState& run);
+  /// Adds what the attempt's wrench analyses counted (local analyses, a tube.mass doubt) to `result`.
+  static void CountAttemptWrench(const Attempt& attempt, CellRunResult& result);
   /// Counts the attempt's outcome; true when the next plan of the same scan may be tried.
   bool CountAttempt(AttemptResult outcome, RunState& run);
   /// A scan without an executable plan: a "no_plan" record, or a nudge and its record.
@@ -369,6 +379,8 @@ class CellController {
   v1::AnalyzeWrenchResponse AnalyzeLift(const devices::WrenchReading& reference,
                                         const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt,
                                         devices::WrenchReading* lifted);
+  /// Adds the lift's tube_ratio to the cell's and records a doubt about tube.mass (CheckTubeMass).
+  void CheckLiftWeights(double tube_ratio, Attempt& attempt);
   /// SINGLE: place; NONE: release; MULTIPLE: nullopt (resolve).
   std::optional<AttemptResult> Conclude(v1::HeldOutcome outcome, const Eigen::Isometry3d& X_BinTcpPlace,
                                         const devices::WrenchReading& reference, Attempt& attempt);
@@ -468,6 +480,9 @@ class CellController {
   std::uint32_t round_ = 0;
   /// Codes of the planner's modeling warnings already logged (PlanPick logs each once).
   std::set<std::string> planner_warnings_seen_;
+  /// tube_ratio of every lift analysed (the most recent 64), oldest first: CheckTubeMass's input.
+  std::vector<double> lift_ratios_;
+  bool tube_mass_doubt_said_ = false;
   /// A stop was requested (RequestStop); stop_why_ (under stop_mutex_) is set before it.
   std::atomic<bool> stop_requested_{false};
   mutable std::mutex stop_mutex_;

@@ -31,7 +31,7 @@ std::vector<physics::TubeGeometry> GenerateTubes(const SimCellParams& p) {
   scene.tube_count = static_cast<int>(p.tubes);
   scene.tubes = p.tube_shape.value_or(DefaultShape(p));
   scene.bin = p.cell.bin;
-  scene.drop.tube_mass = p.cell.tube.mass;
+  scene.drop.tube_mass = p.WorldTubeMass();
   scene.drop.tube_friction = std::sqrt(material.tube_friction);
   scene.drop.bin_friction = material.bin_friction / std::sqrt(material.tube_friction);
   const physics::DropResult drop = physics::GenerateScene(scene, physics::DeriveSeed(p.seed, 1));

@@ -161,6 +161,12 @@ struct SimCellParams {
   std::uint64_t seed = 1;
   /// The cell (bin, sensor pose, tube radius/length/mass, place frame). tube.mass is per tube.
   CellConfig cell;
+  /// What the simulated tubes really weigh, kg, when it is not cell.tube.mass (what the cell says):
+  /// to see what a wrong tube.mass does to a cell. nullopt = cell.tube.mass.
+  std::optional<double> world_tube_mass;
+
+  /// The simulated tubes' mass, kg.
+  double WorldTubeMass() const { return world_tube_mass.value_or(cell.tube.mass); }
   /// F/T noise, standard deviation per axis of each reading (and of the reading Bias takes, so a
   /// biased reading deviates by σ·√2): N and N·m.
   double force_noise = 0.02;

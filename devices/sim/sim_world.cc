@@ -82,7 +82,7 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
 
   TubeBodyOptions options;
   options.rubber = params_.material == Material::kRubber;
-  options.mass = params_.cell.tube.mass;
+  options.mass = params_.WorldTubeMass();
   options.material = material;
   options.body_friction = tube_factor;
   options.body_restitution = restitution_factor;

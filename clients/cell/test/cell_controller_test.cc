@@ -308,6 +308,43 @@ TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
   EXPECT_EQ(attempts[0]["result"], "none");
 }
 
+TEST_F(CellControllerTest, LiftsThatWeighNoWholeNumberOfTubesDoubtTubeMass) {
+  // Tubes lighter than the cell's tube.mass says: each lift weighs about 0.75 tubes, Algorithm 3's
+  // "none" every time. From the third such lift on, the records and the round's line name tube.mass.
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
+                            Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 3u);
+  EXPECT_EQ(result.tube_mass_doubts, 1u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 3u);
+  EXPECT_FALSE(attempts[0].contains("tube_mass_doubt"));
+  EXPECT_FALSE(attempts[1].contains("tube_mass_doubt"));
+  ASSERT_TRUE(attempts[2].contains("tube_mass_doubt"));
+  const json& doubt = attempts[2]["tube_mass_doubt"];
+  EXPECT_EQ(doubt["lifts"], 3);
+  EXPECT_DOUBLE_EQ(doubt["median_ratio"].get<double>(), 0.75);
+  EXPECT_DOUBLE_EQ(doubt["mass_if_single"].get<double>(), 0.75 * cell.tube.mass);
+  const std::string line = DescribeTubeMassDoubt(result);
+  EXPECT_NE(line.find("the lifts doubt tube.mass after 1 of 3 attempts"), std::string::npos) << line;
+  EXPECT_NE(line.find("0.74-0.76 times tube.mass"), std::string::npos) << line;
+  // The decision stays Algorithm 3's: nothing was placed.
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_EQ(attempts[2]["result"], "none");
+}
+
+TEST_F(CellControllerTest, LiftsOfWholeTubesRaiseNoDoubt) {
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
+                            Outcome(v1::HELD_OUTCOME_NONE, 0.85)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 3u);
+  EXPECT_EQ(result.tube_mass_doubts, 0u);
+  EXPECT_EQ(DescribeTubeMassDoubt(result), "");
+}
+
 TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   planner.plan_answers.push_back(
       Plans({MakePlan(5, p_Bin_grasp, v1::TRAJECTORY_KIND_ESCAPE,

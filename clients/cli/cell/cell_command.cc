@@ -44,6 +44,7 @@ struct CellOptions {
   std::string material = "pvc";
   std::string shapes;  ///< --shapes: A, B or C; empty = the material's thesis set (pvc A, rubber B)
   std::string place_zone = "conveyor";  ///< --place-zone: conveyor or table
+  std::optional<double> sim_tube_mass;  ///< --sim-tube-mass: what the simulated tubes weigh, kg
   std::string server = "auto";
   std::uint64_t seed = 1;
   std::string records_path;
@@ -172,6 +173,8 @@ json RoundJson(std::uint32_t round, const cell::CellRunResult& result, double wa
           {"attempts", result.attempts},
           {"scans", result.scans},
           {"planner_warnings", result.planner_warnings},
+          {"tube_mass_doubts", result.tube_mass_doubts},
+          {"tube_mass_doubt", result.tube_mass_doubt},
           {"wall_s", wall}};
 }
 
@@ -181,6 +184,8 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   const devices::DevicesConfig config = devices::LoadDevicesConfig(o.devices_path);
   if (o.fault_rate > 0.0)
     throw InvalidArgument("--inject-faults: only with --sim (faults are injected into the simulated cell)");
+  if (o.sim_tube_mass)
+    throw InvalidArgument("--sim-tube-mass: only with --sim (a real cell's tubes weigh what they weigh)");
   OpenedCell opened = OpenCell(config, o.cell_path);
   fmt::print("devices: robot {}, gripper {}, F/T {}, scanner {}; cell from {}\n",
              devices::ToString(config.robot_driver), devices::ToString(config.gripper_driver),
@@ -224,7 +229,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     fmt::print("round {:>2}: {} | {} picked, {} lost in transit, {} attempts, {} scans, {:.0f} s{}\n", round,
                result.message, result.picks, result.lost, result.attempts, result.scans, wall,
-               cell::DescribePlannerWarnings(result));
+               cell::DescribePlannerWarnings(result) + cell::DescribeTubeMassDoubt(result));
     std::fflush(stdout);
     rounds_json.push_back(RoundJson(round, result, wall));
     if (result.reason != cell::CellStopReason::kBinEmpty &&
@@ -306,6 +311,7 @@ void Run(const CellOptions& o) {
     if (custom_cell) sim_params.cell = cell_config;
     if (!o.shapes.empty()) WithShapes(o.shapes, &sim_params);
     sim_params.place_zone_conveyor = o.place_zone == "conveyor";
+    sim_params.world_tube_mass = o.sim_tube_mass;
     if (server) {
       server->AwaitBack();
       server->StartAgain();  // an outage the last round ended in
@@ -329,7 +335,8 @@ void Run(const CellOptions& o) {
         "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall{}\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         r.tubes_unnoticed > 0 ? fmt::format("{} carried out unnoticed, ", r.tubes_unnoticed) : "",
-        result.attempts, result.scans, r.simulated_s, wall, cell::DescribePlannerWarnings(result));
+        result.attempts, result.scans, r.simulated_s, wall,
+        cell::DescribePlannerWarnings(result) + cell::DescribeTubeMassDoubt(result));
     std::fflush(stdout);
     json round_json = RoundJson(round, result, wall);
     round_json.update({{"seed", o.seed + round},
@@ -413,6 +420,10 @@ void AddCellCommand(CLI::App& app) {
          "or a table where placed tubes pile up")
       ->check(CLI::IsMember({"conveyor", "table"}))
       ->capture_default_str();
+  cmd->add_option("--sim-tube-mass", o->sim_tube_mass,
+                  "With --sim: what the simulated tubes weigh, kg, when not the cell's tube.mass (which the "
+                  "controller and planner still use): shows what a wrong tube.mass does")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--server", o->server,
                   "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
       ->capture_default_str();
