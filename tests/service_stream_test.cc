@@ -276,6 +276,11 @@ TEST(ServiceStreamAdmission, UploadsHaveTheirOwnLimitAndErrorsReleaseTheirSlot) 
   const grpc::Status unary =
       server.stub().PlanPick(&unary_context, PlanRequest(ThreeTubeCloud()), &unary_response);
   EXPECT_TRUE(unary.ok()) << unary.error_message();
+  // Its worker counts itself free only after the answer has left: until then B and D could find it
+  // still running, and the second of them the queue full (seen once in CI).
+  ASSERT_TRUE(WaitFor(
+      [&] { return MetricValue(ScrapeMetrics(server.metrics_port()), "tubepick_workers_busy") == 0.0; },
+      std::chrono::seconds(10)));
 
   // A fails (duplicate chunk) and gives its slot back: a new stream D is admitted.
   a->writer->Write(messages[1]);
