@@ -1,11 +1,12 @@
 #include "server/metrics.h"
 
-#include <dlfcn.h>
 #include <fmt/format.h>
 
 #include <fstream>
 #include <iterator>
 #include <sstream>
+
+#include "server/allocator.h"
 
 namespace tubepick::server {
 namespace {
@@ -39,27 +40,6 @@ std::optional<ProcessMemory> ReadProcessMemory() {
   }
   if (!rss || !hwm) return std::nullopt;
   return memory;
-}
-
-std::optional<AllocatorMemory> ReadAllocatorMemory() {
-  // jemalloc's mallctl, looked up at run time: the library does not link jemalloc, tubepick-server does.
-  using Mallctl = int (*)(const char*, void*, std::size_t*, void*, std::size_t);
-  static const auto mallctl = reinterpret_cast<Mallctl>(::dlsym(RTLD_DEFAULT, "mallctl"));
-  if (mallctl == nullptr) return std::nullopt;
-  // The statistics are a snapshot taken when the epoch advances.
-  std::uint64_t epoch = 1;
-  std::size_t epoch_size = sizeof(epoch);
-  if (mallctl("epoch", &epoch, &epoch_size, &epoch, epoch_size) != 0) return std::nullopt;
-  const auto read = [](const char* name) -> std::optional<std::uint64_t> {
-    std::size_t value = 0;
-    std::size_t size = sizeof(value);
-    if (mallctl(name, &value, &size, nullptr, 0) != 0) return std::nullopt;
-    return value;
-  };
-  const std::optional<std::uint64_t> allocated = read("stats.allocated");
-  const std::optional<std::uint64_t> resident = read("stats.resident");
-  if (!allocated || !resident) return std::nullopt;
-  return AllocatorMemory{*allocated, *resident};
 }
 
 Metrics::Metrics() {

@@ -27,20 +27,6 @@ struct ProcessMemory {
 /// nullopt where /proc is not available.
 std::optional<ProcessMemory> ReadProcessMemory();
 
-/// The allocator's own account of its memory (jemalloc's stats.*), bytes. It tells a leak from the
-/// allocator's cache: `allocated` is what live objects hold and grows with a leak; `resident` adds the
-/// freed pages jemalloc keeps for reuse until they have been unused for ~10 s, which is most of the
-/// swing of the process RSS under load.
-struct AllocatorMemory {
-  /// stats.allocated: bytes in live allocations.
-  std::uint64_t allocated = 0;
-  /// stats.resident: bytes of the allocator's pages that are resident (live, cached and metadata).
-  std::uint64_t resident = 0;
-};
-/// nullopt when the process does not allocate with jemalloc (tests, sanitizer builds) or its
-/// statistics are unavailable.
-std::optional<AllocatorMemory> ReadAllocatorMemory();
-
 /// The service's counters and histograms, rendered in the Prometheus text exposition format
 /// (version 0.0.4). Thread-safe; recording is a short critical section per call.
 class Metrics {

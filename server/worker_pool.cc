@@ -1,6 +1,5 @@
 #include "server/worker_pool.h"
 
-#include <dlfcn.h>
 #include <malloc.h>
 
 #include <spdlog/spdlog.h>
@@ -8,6 +7,8 @@
 #include <cassert>
 #include <exception>
 #include <utility>
+
+#include "server/allocator.h"
 
 namespace tubepick::server {
 namespace {
@@ -24,8 +25,7 @@ bool GlibcHeap() {
   return false;
 #endif
 #endif
-  static const bool glibc = ::dlsym(RTLD_DEFAULT, "mallctl") == nullptr;
-  return glibc;
+  return !UsesJemalloc();
 #endif
 }
 

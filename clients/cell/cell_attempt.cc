@@ -214,7 +214,6 @@ void CellController::CheckLiftWeights(double tube_ratio, Attempt& attempt) {
                                        {"median_ratio", doubt->median_ratio},
                                        {"tube_mass", doubt->tube_mass},
                                        {"mass_if_single", doubt->mass_if_single}};
-  attempt.tube_mass_doubt = doubt->message;
   spdlog::log(tube_mass_doubt_said_ ? spdlog::level::debug : spdlog::level::warn, "cell: round {}: {}{}",
               round_, doubt->message,
               tube_mass_doubt_said_ ? "" : " (said once; the attempt records carry it as tube_mass_doubt)");

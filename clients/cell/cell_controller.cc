@@ -101,6 +101,10 @@ std::string DescribeTubeMassDoubt(const CellRunResult& result) {
                      result.attempts, result.tube_mass_doubt);
 }
 
+std::string DescribeRoundWarnings(const CellRunResult& result) {
+  return DescribePlannerWarnings(result) + DescribeTubeMassDoubt(result);
+}
+
 std::string ToString(CellStopReason reason) {
   switch (reason) {
     case CellStopReason::kBinEmpty:
@@ -356,9 +360,9 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
 
 void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& result) {
   result.local_analyses += attempt.local_analyses;
-  if (attempt.tube_mass_doubt) {
+  if (const auto doubt = attempt.record.find("tube_mass_doubt"); doubt != attempt.record.end()) {
     ++result.tube_mass_doubts;
-    result.tube_mass_doubt = *attempt.tube_mass_doubt;
+    result.tube_mass_doubt = doubt->at("message").get<std::string>();
   }
 }
 

@@ -126,6 +126,9 @@ std::string DescribePlannerWarnings(const CellRunResult& result);
 /// when no lift of the round did.
 std::string DescribeTubeMassDoubt(const CellRunResult& result);
 
+/// Both of the above, as the round's line ends.
+std::string DescribeRoundWarnings(const CellRunResult& result);
+
 /// What a command of a run does (PlannedMotion).
 enum class MotionKind {
   kTransit,        ///< Robot::MoveTo each pose of `via`, then X_BinTcp, at transit speed (up, across, down)

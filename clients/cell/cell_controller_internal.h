@@ -78,8 +78,6 @@ struct CellController::Attempt {
   double analysis_wall_s = 0.0;
   /// AnalyzeWrench calls the local fallback answered.
   std::uint32_t local_analyses = 0;
-  /// Set when, after this attempt's lift, the recent lifts doubt tube.mass (CheckTubeMass).
-  std::optional<std::string> tube_mass_doubt;
   detail::Clock::time_point started = detail::Clock::now();
   double device_started = 0.0;
   std::optional<AttemptResult> result;

@@ -229,7 +229,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - round_start).count();
     fmt::print("round {:>2}: {} | {} picked, {} lost in transit, {} attempts, {} scans, {:.0f} s{}\n", round,
                result.message, result.picks, result.lost, result.attempts, result.scans, wall,
-               cell::DescribePlannerWarnings(result) + cell::DescribeTubeMassDoubt(result));
+               cell::DescribeRoundWarnings(result));
     std::fflush(stdout);
     rounds_json.push_back(RoundJson(round, result, wall));
     if (result.reason != cell::CellStopReason::kBinEmpty &&
@@ -335,8 +335,7 @@ void Run(const CellOptions& o) {
         "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall{}\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         r.tubes_unnoticed > 0 ? fmt::format("{} carried out unnoticed, ", r.tubes_unnoticed) : "",
-        result.attempts, result.scans, r.simulated_s, wall,
-        cell::DescribePlannerWarnings(result) + cell::DescribeTubeMassDoubt(result));
+        result.attempts, result.scans, r.simulated_s, wall, cell::DescribeRoundWarnings(result));
     std::fflush(stdout);
     json round_json = RoundJson(round, result, wall);
     round_json.update({{"seed", o.seed + round},

@@ -112,11 +112,8 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
       last_allocated.push_back(r.allocated_bytes);
     }
   }
-  const auto percent = [](std::uint64_t from, std::uint64_t to) {
-    return from == 0
-               ? 0.0
-               : 100.0 * (static_cast<double>(to) - static_cast<double>(from)) / static_cast<double>(from);
-  };
+  // The change from `from` to `to`, percent; 0 when there is nothing to compare with.
+  const auto percent = [](double from, double to) { return from > 0.0 ? 100.0 * (to - from) / from : 0.0; };
   const auto median = [](std::vector<std::uint64_t>& v) -> std::uint64_t {
     if (v.empty()) return 0;
     // Nearest rank: the ceil(n / 2)-th smallest.
@@ -131,37 +128,44 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
   };
   s.first_window_mean = mean(first);
   s.last_window_mean = mean(last);
-  if (s.first_window_mean > 0.0)
-    s.mean_growth_percent = 100.0 * (s.last_window_mean - s.first_window_mean) / s.first_window_mean;
+  s.mean_growth_percent = percent(s.first_window_mean, s.last_window_mean);
   if (!first.empty()) s.first_window_max = *std::max_element(first.begin(), first.end());
   if (!last.empty()) s.last_window_max = *std::max_element(last.begin(), last.end());
   s.first_window_samples = first.size();
   s.last_window_samples = last.size();
   s.first_window_median = median(first);
   s.last_window_median = median(last);
-  s.growth_percent = percent(s.first_window_max, s.last_window_max);
-  s.median_growth_percent = percent(s.first_window_median, s.last_window_median);
+  s.growth_percent = percent(static_cast<double>(s.first_window_max), static_cast<double>(s.last_window_max));
+  s.median_growth_percent =
+      percent(static_cast<double>(s.first_window_median), static_cast<double>(s.last_window_median));
   const auto all_have = [](const std::vector<std::uint64_t>& v) {
     return !v.empty() && std::find(v.begin(), v.end(), 0u) == v.end();
   };
   if (all_have(first_allocated) && all_have(last_allocated)) {
     s.first_window_allocated_mean = mean(first_allocated);
     s.last_window_allocated_mean = mean(last_allocated);
-    s.allocated_growth_percent = 100.0 * (s.last_window_allocated_mean - s.first_window_allocated_mean) /
-                                 s.first_window_allocated_mean;
+    s.allocated_growth_percent = percent(s.first_window_allocated_mean, s.last_window_allocated_mean);
   }
   return s;
 }
 
+namespace {
+
+// Why either window is too thin to judge (the endpoint was not answering), or std::nullopt.
+std::optional<std::string> TooFewSamples(const RssSummary& s, std::size_t min_window_samples) {
+  if (s.first_window_samples >= min_window_samples && s.last_window_samples >= min_window_samples)
+    return std::nullopt;
+  return fmt::format(
+      "too few RSS samples to judge: {} in the first {:.0f} s, {} in the last, at least {} needed ({} failed "
+      "scrapes)",
+      s.first_window_samples, s.window_seconds, s.last_window_samples, min_window_samples, s.failed_scrapes);
+}
+
+}  // namespace
+
 std::optional<std::string> RssGrowthFailure(const RssSummary& s, double max_growth_percent,
                                             std::size_t min_window_samples) {
-  if (s.first_window_samples < min_window_samples || s.last_window_samples < min_window_samples)
-    return fmt::format(
-        "too few RSS samples to judge: {} in the first {:.0f} s, {} in the last, at least {} needed ({} "
-        "failed "
-        "scrapes)",
-        s.first_window_samples, s.window_seconds, s.last_window_samples, min_window_samples,
-        s.failed_scrapes);
+  if (auto thin = TooFewSamples(s, min_window_samples)) return thin;
   if (s.mean_growth_percent > max_growth_percent)
     return fmt::format(
         "server RSS grew {:+.1f} % (mean of the last {:.0f} s {:.1f} MB against {:.1f} MB in the first "
@@ -173,19 +177,16 @@ std::optional<std::string> RssGrowthFailure(const RssSummary& s, double max_grow
 
 std::optional<std::string> AllocatedGrowthFailure(const RssSummary& s, double max_growth_percent,
                                                   std::size_t min_window_samples) {
-  if (s.first_window_samples < min_window_samples || s.last_window_samples < min_window_samples)
-    return RssGrowthFailure(s, max_growth_percent, min_window_samples);
+  if (auto thin = TooFewSamples(s, min_window_samples)) return thin;
   if (s.first_window_allocated_mean <= 0.0 || s.last_window_allocated_mean <= 0.0)
     return std::string(
         "the server exported no tubepick_allocator_allocated_bytes in every scrape of both windows (a server "
         "without jemalloc, e.g. a sanitizer build): its live bytes cannot be judged");
   if (s.allocated_growth_percent > max_growth_percent)
     return fmt::format(
-        "the server's live bytes grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean of the last {:.0f} "
-        "s "
-        "{:.1f} MB against {:.1f} MB in the first {:.0f} s after {:.0f} s of settling), more than the {:.1f} "
-        "% "
-        "allowed: a leak",
+        "the server's live bytes grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean of the last "
+        "{:.0f} s {:.1f} MB against {:.1f} MB in the first {:.0f} s after {:.0f} s of settling), more than "
+        "the {:.1f} % allowed: a leak",
         s.allocated_growth_percent, s.window_seconds, s.last_window_allocated_mean / 1e6,
         s.first_window_allocated_mean / 1e6, s.window_seconds, s.settle_seconds, max_growth_percent);
   return std::nullopt;
