@@ -104,6 +104,23 @@ TEST(CellCliTest, TubesHeavierThanTheCellSaysAreNamedInTheRoundLine) {
             std::string::npos);
 }
 
+TEST(CellCliTest, ASimulatedTubeMassOnlyWithSimAndPositive) {
+  const testing::CliRun without_sim = RunCli("cell --rounds 1 --sim-tube-mass 0.08");
+  EXPECT_NE(without_sim.exit_code, 0) << without_sim.output;
+  EXPECT_NE(without_sim.output.find("--sim-tube-mass requires --sim"), std::string::npos)
+      << without_sim.output;
+  const testing::CliRun zero = RunCli("cell --sim --rounds 1 --sim-tube-mass 0");
+  EXPECT_NE(zero.exit_code, 0) << zero.output;
+  EXPECT_NE(zero.output.find("--sim-tube-mass: Value 0 not in range"), std::string::npos) << zero.output;
+}
+
+TEST(CellCliTest, LoadRefusesANegativeSettlingTime) {
+  // `tubepick load`'s new option, checked before any connection is tried.
+  const testing::CliRun run = RunCli("load --target 127.0.0.1:1 --clouds . --duration 1 --rss-settle -1");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("--rss-settle: Value -1 not in range"), std::string::npos) << run.output;
+}
+
 TEST(CellCliTest, InjectedFaultRateOutsideZeroToOneIsRefused) {
   const testing::CliRun run = RunCli("cell --sim --rounds 1 --inject-faults 5");
   EXPECT_EQ(run.exit_code, 2) << run.output;

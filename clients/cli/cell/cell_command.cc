@@ -184,8 +184,6 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   const devices::DevicesConfig config = devices::LoadDevicesConfig(o.devices_path);
   if (o.fault_rate > 0.0)
     throw InvalidArgument("--inject-faults: only with --sim (faults are injected into the simulated cell)");
-  if (o.sim_tube_mass)
-    throw InvalidArgument("--sim-tube-mass: only with --sim (a real cell's tubes weigh what they weigh)");
   OpenedCell opened = OpenCell(config, o.cell_path);
   fmt::print("devices: robot {}, gripper {}, F/T {}, scanner {}; cell from {}\n",
              devices::ToString(config.robot_driver), devices::ToString(config.gripper_driver),
@@ -383,7 +381,8 @@ void AddCellCommand(CLI::App& app) {
       "cell",
       "Run bin-picking rounds on a cell's devices (--devices) or in the simulated cell (--sim); "
       "thesis Tables 5.4-5.9");
-  cmd->add_flag("--sim", o->sim, "Use the simulated cell (Bullet world behind all four devices)");
+  CLI::Option* sim =
+      cmd->add_flag("--sim", o->sim, "Use the simulated cell (Bullet world behind all four devices)");
   cmd->add_option("--devices", o->devices_path,
                   "Devices YAML of a real (or virtual) cell: a driver and connection per device "
                   "(--print-devices-config prints an example; check it with `tubepick devices check`)")
@@ -422,7 +421,8 @@ void AddCellCommand(CLI::App& app) {
   cmd->add_option("--sim-tube-mass", o->sim_tube_mass,
                   "With --sim: what the simulated tubes weigh, kg, when not the cell's tube.mass (which the "
                   "controller and planner still use): shows what a wrong tube.mass does")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->needs(sim);
   cmd->add_option("--server", o->server,
                   "Planner address HOST:PORT, or auto: start tubepick-server on loopback")
       ->capture_default_str();
