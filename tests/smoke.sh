@@ -169,7 +169,8 @@ done
 if bufcurl --list-methods "http://127.0.0.1:$PORT" >"$WORK/methods-off.txt" 2>&1; then
   fail "reflection: false still lists methods: $(tr '\n' ' ' <"$WORK/methods-off.txt")"
 fi
-"$CLI" health --target "127.0.0.1:$PORT" >"$WORK/health-off.txt" 2>&1 || fail "health with reflection off"
+"$CLI" health --target "127.0.0.1:$PORT" >"$WORK/health-off.txt" 2>&1 ||
+  fail "health with reflection off: $(tr '\n' ' ' <"$WORK/health-off.txt")"
 kill -TERM "$SERVER_PID"
 wait "$SERVER_PID" || fail "server with reflection off: non-zero exit after SIGTERM"
 SERVER_PID=""
