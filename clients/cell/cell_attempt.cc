@@ -205,7 +205,9 @@ void CellController::CheckLiftWeights(double tube_ratio, Attempt& attempt) {
   constexpr std::size_t kKept = 64;
   lift_ratios_.push_back(tube_ratio);
   if (lift_ratios_.size() > kKept) lift_ratios_.erase(lift_ratios_.begin());
-  const std::optional<TubeMassDoubt> doubt = CheckTubeMass(lift_ratios_, cell_.tube.mass);
+  if (!params_.tube_mass_check.enabled) return;
+  const std::optional<TubeMassDoubt> doubt =
+      CheckTubeMass(lift_ratios_, cell_.tube.mass, params_.tube_mass_check.limits);
   if (!doubt) return;
   attempt.record["tube_mass_doubt"] = {{"message", doubt->message},
                                        {"lifts", doubt->lifts},

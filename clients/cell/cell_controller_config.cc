@@ -83,6 +83,15 @@ void DescribeFields(Visit& v, CellFrameCheckParams& c) {
     "rad, the same for the turn (a half turn about z is the same frame)");
 }
 
+template <typename Visit>
+void DescribeFields(Visit& v, LiftWeightCheckParams& c) {
+  v("enabled", c.enabled, "warn when the lifts' weights fit no whole number of tubes of tube.mass");
+  v("window", c.limits.window, "the most recent lifts that held something, judged together");
+  v("min_lifts", c.limits.min_lifts, "of them, at least this many");
+  v("min_held_ratio", c.limits.min_held_ratio, "tubes' worth: a lift this heavy held something");
+  v("max_off_whole", c.limits.max_off_whole, "tubes' worth a lift may lie from a whole number and fit");
+}
+
 namespace {
 
 template <typename Visit>
@@ -157,6 +166,9 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
   v("ft_spike_torque", p.ft_spike_torque, "N*m off the median: a spike, dropped");
   v("ft_unsettled_retries", p.ft_unsettled_retries,
     "measures again after one whose readings mostly disagreed");
+  v.Section("tube_mass_check", p.tube_mass_check,
+            "each of the last `window` lifts more than max_off_whole from every whole number of\n"
+            "tubes: tube.mass is doubted (logged once, recorded with every attempt)");
   v.Heading("scanner");
   v("scan_retries", p.scan_retries, "scans again after a timeout or an empty scan");
   DescribePlannerFields(v, p);

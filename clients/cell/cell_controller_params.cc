@@ -86,6 +86,11 @@ void CellControllerParams::Validate() const {
   RequirePositiveCount(ft_samples, "ft_samples");
   RequirePositiveValue(ft_spike_force, "ft_spike_force");
   RequirePositiveValue(ft_spike_torque, "ft_spike_torque");
+  try {
+    tube_mass_check.limits.Validate();
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(fmt::format("cell controller {}", e.what()));
+  }
   RequirePositiveCount(max_plans_per_scan, "max_plans_per_scan");
   RequirePositiveDuration(plan_deadline, "plan_deadline");
   RequirePositiveDuration(analyze_deadline, "analyze_deadline");

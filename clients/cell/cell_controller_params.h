@@ -11,10 +11,18 @@
 #include "clients/cell/nudge.h"
 #include "clients/cell/tool_clearance.h"
 #include "core/common/cell_config.h"
+#include "core/wrench/tube_mass_check.h"
 #include "devices/device_error.h"
 #include "tubepick/v1/wrench.pb.h"
 
 namespace tubepick::cell {
+
+/// The controller's check of its lifts' weights against tube.mass (CheckTubeMass's limits). A cell
+/// that lifts parts of different weights on purpose turns it off.
+struct LiftWeightCheckParams {
+  bool enabled = true;
+  TubeMassCheckParams limits;
+};
 
 /// Everything the cell controller decides by itself: speeds, heights, the planner options, the
 /// attempt limits and the timeouts. Every field has a default that suits the simulated cell and the
@@ -97,6 +105,9 @@ struct CellControllerParams {
   /// a saturated gauge does not (in the simulated set-C rounds one such measurement was steady at
   /// the next try; one that stayed off through three still safe-stopped its round, docs/ACCURACY.md).
   std::uint32_t ft_unsettled_retries = 2;
+  /// Whether the lifts' weights still fit the cell's tube.mass (CheckTubeMass): a doubt is logged once
+  /// and recorded with every attempt from then on; Algorithm 3's decisions are unchanged.
+  LiftWeightCheckParams tube_mass_check;
 
   // --- scanner ---
   /// Further scans after a scan that timed out or returned no point, before it is a fault.

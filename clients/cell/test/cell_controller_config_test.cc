@@ -50,6 +50,11 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.cell_check.bin_margin, b.cell_check.bin_margin);
   EXPECT_EQ(a.cell_check.place_position_tolerance, b.cell_check.place_position_tolerance);
   EXPECT_EQ(a.cell_check.place_rotation_tolerance, b.cell_check.place_rotation_tolerance);
+  EXPECT_EQ(a.tube_mass_check.enabled, b.tube_mass_check.enabled);
+  EXPECT_EQ(a.tube_mass_check.limits.window, b.tube_mass_check.limits.window);
+  EXPECT_EQ(a.tube_mass_check.limits.min_lifts, b.tube_mass_check.limits.min_lifts);
+  EXPECT_EQ(a.tube_mass_check.limits.min_held_ratio, b.tube_mass_check.limits.min_held_ratio);
+  EXPECT_EQ(a.tube_mass_check.limits.max_off_whole, b.tube_mass_check.limits.max_off_whole);
   EXPECT_EQ(a.gripper_speed, b.gripper_speed);
   EXPECT_EQ(a.gripper_force, b.gripper_force);
   EXPECT_EQ(a.ft_settle_samples, b.ft_settle_samples);
@@ -144,6 +149,11 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.cell_check.bin_margin = 0.035;
   p.cell_check.place_position_tolerance = 0.08;
   p.cell_check.place_rotation_tolerance = 0.25;
+  p.tube_mass_check.enabled = false;
+  p.tube_mass_check.limits.window = 7;
+  p.tube_mass_check.limits.min_lifts = 4;
+  p.tube_mass_check.limits.min_held_ratio = 0.4;
+  p.tube_mass_check.limits.max_off_whole = 0.15;
   p.ft_samples = 9;
   p.max_plans_per_scan = 3;
   p.max_attempts_per_tube = 5;
@@ -280,6 +290,28 @@ TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {
       << ParseError("cell_check:\n  place_rotation_tolerance: 20\n");
   EXPECT_NE(ParseError("cell_check:\n  margin: 0.1\n").find("cell_check.margin"), std::string::npos);
   EXPECT_NE(ParseError("cell_check:\n  enabled: perhaps\n").find("cell_check.enabled"), std::string::npos);
+}
+
+TEST(CellControllerConfigTest, TubeMassCheckKeysAreReadAndCheckedNamingThem) {
+  const CellControllerParams p =
+      ParseCellControllerParams("tube_mass_check:\n  window: 8\n  max_off_whole: 0.25\n");
+  EXPECT_EQ(p.tube_mass_check.limits.window, 8u);
+  EXPECT_EQ(p.tube_mass_check.limits.max_off_whole, 0.25);
+  EXPECT_TRUE(p.tube_mass_check.enabled);
+  EXPECT_EQ(p.tube_mass_check.limits.min_lifts, TubeMassCheckParams{}.min_lifts);
+  EXPECT_FALSE(ParseCellControllerParams("tube_mass_check:\n  enabled: false\n").tube_mass_check.enabled);
+  const std::string yaml = DumpCellControllerParams(CellControllerParams{});
+  EXPECT_NE(yaml.find("tube_mass_check:"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("max_off_whole: 0.2"), std::string::npos) << yaml;
+
+  const std::string too_many = ParseError("tube_mass_check:\n  window: 2\n");
+  EXPECT_NE(too_many.find("cell controller tube_mass_check.min_lifts: 3 is outside [1, window = 2]"),
+            std::string::npos)
+      << too_many;
+  const std::string half = ParseError("tube_mass_check:\n  max_off_whole: 0.5\n");
+  EXPECT_NE(half.find("tube_mass_check.max_off_whole: 0.5 is outside (0, 0.5)"), std::string::npos) << half;
+  EXPECT_NE(ParseError("tube_mass_check:\n  tolerance: 0.1\n").find("tube_mass_check.tolerance"),
+            std::string::npos);
 }
 
 TEST(CellControllerConfigTest, LoadNamesTheFile) {

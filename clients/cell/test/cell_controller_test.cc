@@ -345,6 +345,33 @@ TEST_F(CellControllerTest, LiftsOfWholeTubesRaiseNoDoubt) {
   EXPECT_EQ(DescribeTubeMassDoubt(result), "");
 }
 
+TEST_F(CellControllerTest, TheTubeMassCheckTakesItsLimitsFromTheControllerParams) {
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
+                            Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
+  params.tube_mass_check.limits.window = 2;
+  params.tube_mass_check.limits.min_lifts = 2;
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 3u);
+  EXPECT_EQ(result.tube_mass_doubts, 2u);  // from the second lift on
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 3u);
+  EXPECT_FALSE(attempts[0].contains("tube_mass_doubt"));
+  ASSERT_TRUE(attempts[1].contains("tube_mass_doubt"));
+  EXPECT_EQ(attempts[1]["tube_mass_doubt"]["lifts"], 2);
+}
+
+TEST_F(CellControllerTest, ATubeMassCheckTurnedOffRecordsNoDoubt) {
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
+                            Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
+  params.tube_mass_check.enabled = false;
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 3u);
+  EXPECT_EQ(result.tube_mass_doubts, 0u);
+  for (const json& attempt : Records("attempt")) EXPECT_FALSE(attempt.contains("tube_mass_doubt"));
+}
+
 TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   planner.plan_answers.push_back(
       Plans({MakePlan(5, p_Bin_grasp, v1::TRAJECTORY_KIND_ESCAPE,
