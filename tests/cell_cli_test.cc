@@ -104,6 +104,19 @@ TEST(CellCliTest, TubesHeavierThanTheCellSaysAreNamedInTheRoundLine) {
             std::string::npos);
 }
 
+TEST(CellCliTest, TubesTenTimesLighterThanTheCellSaysAreNamedThoughEveryLiftReadsNone) {
+  // The simulated PVC tubes weigh 0.0055 kg where the cell says 0.055 kg (grams taken for a tenth):
+  // every lift reads about a tenth of a tube, Algorithm 3's "none", while the gripper holds a tube. The
+  // round stops at its attempt limit, and its line says why.
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 3 --seed 1 --sim-tube-mass 0.0055");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("attempt limit reached"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("the lifts doubt tube.mass after"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("though the gripper held something each time: is tube.mass right?"),
+            std::string::npos)
+      << run.output;
+}
+
 TEST(CellCliTest, ASimulatedTubeMassOnlyWithSimAndPositive) {
   const testing::CliRun without_sim = RunCli("cell --rounds 1 --sim-tube-mass 0.08");
   EXPECT_NE(without_sim.exit_code, 0) << without_sim.output;

@@ -1,5 +1,7 @@
 #include "clients/cell/attempt_record.h"
 
+#include <fmt/core.h>
+
 #include "clients/cell/cell_records.h"
 #include "wire/proto_convert.h"
 
@@ -61,6 +63,13 @@ nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis) {
           {"held_weight", analysis.held_weight()},
           {"tube_weight", analysis.tube_weight()},
           {"motions", analysis.resolution_motions_size()}};
+}
+
+std::string DescribeAttemptBriefly(const nlohmann::json& record) {
+  if (const auto a = record.find("analysis"); a != record.end() && a->is_object()) {
+    return fmt::format("{} {:.2f} tubes", a->value("outcome", ""), a->value("tube_ratio", 0.0));
+  }
+  return record.value("result", "unfinished");
 }
 
 nlohmann::json ResolutionJson(int available) {

@@ -4,6 +4,7 @@
 #include "clients/cell/cell_controller.h"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <utility>
@@ -219,14 +220,16 @@ void CellController::StartCell() {
 
 std::optional<std::string> CellController::LimitReached(const RunState& run) const {
   if (run.attempts_since_pick >= params_.max_attempts_per_tube)
-    return fmt::format("{} attempts since the last pick (max_attempts_per_tube = {})",
-                       run.attempts_since_pick, params_.max_attempts_per_tube);
+    return fmt::format("{} attempts since the last pick (max_attempts_per_tube = {}: {})",
+                       run.attempts_since_pick, params_.max_attempts_per_tube,
+                       fmt::join(run.since_pick, ", "));
   if (run.result.attempts >= params_.max_attempts_per_bin)
     return fmt::format("{} attempts in this bin (max_attempts_per_bin = {})", run.result.attempts,
                        params_.max_attempts_per_bin);
   if (run.consecutive_failures >= params_.max_consecutive_failures)
-    return fmt::format("{} consecutive failures (max_consecutive_failures = {})", run.consecutive_failures,
-                       params_.max_consecutive_failures);
+    return fmt::format("{} consecutive failures (max_consecutive_failures = {}{}{})",
+                       run.consecutive_failures, params_.max_consecutive_failures,
+                       run.since_pick.empty() ? "" : "; attempts: ", fmt::join(run.since_pick, ", "));
   return std::nullopt;
 }
 
@@ -350,6 +353,7 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   d["attempt_device_s"] = DeviceNow() - attempt.device_started;
   record["truth_after"] = Truth();
   CountAttemptWrench(attempt, run.result);
+  run.since_pick.push_back(DescribeAttemptBriefly(record));
   if (sink_) sink_->Write(record);
   spdlog::info("cell: round {} attempt {}: tube {} {} -> {}", round_, run.result.attempts,
                record.value("tube", 0u), record.value("trajectory_kind", ""),
@@ -371,6 +375,7 @@ bool CellController::CountAttempt(AttemptResult outcome, RunState& run) {
   if (outcome == AttemptResult::kPicked) {
     ++run.result.picks;
     run.attempts_since_pick = 0;
+    run.since_pick.clear();
     run.consecutive_failures = 0;
     run.nudges_since_pick = 0;
     return false;

@@ -88,7 +88,7 @@ void DescribeFields(Visit& v, LiftWeightCheckParams& c) {
   v("enabled", c.enabled, "warn when the lifts' weights fit no whole number of tubes of tube.mass");
   v("window", c.limits.window, "the most recent lifts that held something, judged together");
   v("min_lifts", c.limits.min_lifts, "of them, at least this many");
-  v("min_held_ratio", c.limits.min_held_ratio, "tubes' worth: a lift this heavy held something");
+  v("max_tubes_per_lift", c.limits.max_tubes_per_lift, "the most tubes one lift is believed to hold");
   v("max_off_whole", c.limits.max_off_whole, "tubes' worth a lift may lie from a whole number and fit");
 }
 
@@ -168,7 +168,8 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
     "measures again after one whose readings mostly disagreed");
   v.Section("tube_mass_check", p.tube_mass_check,
             "each of the last `window` lifts more than max_off_whole from every whole number of\n"
-            "tubes: tube.mass is doubted (logged once, recorded with every attempt)");
+            "tubes from 1 to max_tubes_per_lift: tube.mass is doubted (logged once, recorded with\n"
+            "every attempt)");
   v.Heading("scanner");
   v("scan_retries", p.scan_retries, "scans again after a timeout or an empty scan");
   DescribePlannerFields(v, p);

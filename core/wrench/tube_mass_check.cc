@@ -15,9 +15,7 @@ void TubeMassCheckParams::Validate() const {
   if (min_lifts < 1 || min_lifts > window)
     throw InvalidArgument(
         fmt::format("tube_mass_check.min_lifts: {} is outside [1, window = {}]", min_lifts, window));
-  if (!(min_held_ratio > 0.0 && min_held_ratio < 1.0))
-    throw InvalidArgument(
-        fmt::format("tube_mass_check.min_held_ratio: {} is outside (0, 1)", min_held_ratio));
+  if (max_tubes_per_lift < 1) throw InvalidArgument("tube_mass_check.max_tubes_per_lift: must be at least 1");
   if (!(max_off_whole > 0.0 && max_off_whole < 0.5))
     throw InvalidArgument(
         fmt::format("tube_mass_check.max_off_whole: {} is outside (0, 0.5)", max_off_whole));
@@ -30,11 +28,12 @@ std::optional<TubeMassDoubt> CheckTubeMass(const std::vector<double>& tube_ratio
   std::vector<double> held;  // most recent first
   for (auto it = tube_ratios.rbegin(); it != tube_ratios.rend() && held.size() < params.window; ++it) {
     RequireFinite(*it, "tube_ratio");
-    if (*it >= params.min_held_ratio) held.push_back(*it);
+    held.push_back(*it);
   }
   if (held.size() < params.min_lifts) return std::nullopt;
+  const double most = static_cast<double>(params.max_tubes_per_lift);
   for (const double r : held) {
-    const double whole = std::max(1.0, std::round(r));
+    const double whole = std::clamp(std::round(r), 1.0, most);
     if (std::abs(r - whole) <= params.max_off_whole) return std::nullopt;
   }
   TubeMassDoubt d;
@@ -47,10 +46,11 @@ std::optional<TubeMassDoubt> CheckTubeMass(const std::vector<double>& tube_ratio
   d.tube_mass = tube_mass;
   d.mass_if_single = tube_mass * d.median_ratio;
   d.message = fmt::format(
-      "the last {} lifts weighed {:.2f}-{:.2f} times tube.mass ({:.3f} kg), none a whole number of tubes: is "
-      "tube.mass right? One tube per lift would weigh {:.3f} kg. Every lift is judged against tube.mass: "
-      "with it wrong, a single pick can read as none or several",
-      d.lifts, d.min_ratio, d.max_ratio, tube_mass, d.mass_if_single);
+      "the last {} lifts weighed {:.2f}-{:.2f} times tube.mass ({:.3f} kg), none a whole number of tubes "
+      "from 1 to {}, though the gripper held something each time: is tube.mass right? One tube per lift "
+      "would weigh {:.3f} kg. Every lift is judged against tube.mass: with it wrong, a single pick can "
+      "read as none or several",
+      d.lifts, d.min_ratio, d.max_ratio, tube_mass, params.max_tubes_per_lift, d.mass_if_single);
   return d;
 }
 

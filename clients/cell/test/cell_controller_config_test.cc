@@ -53,7 +53,7 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.tube_mass_check.enabled, b.tube_mass_check.enabled);
   EXPECT_EQ(a.tube_mass_check.limits.window, b.tube_mass_check.limits.window);
   EXPECT_EQ(a.tube_mass_check.limits.min_lifts, b.tube_mass_check.limits.min_lifts);
-  EXPECT_EQ(a.tube_mass_check.limits.min_held_ratio, b.tube_mass_check.limits.min_held_ratio);
+  EXPECT_EQ(a.tube_mass_check.limits.max_tubes_per_lift, b.tube_mass_check.limits.max_tubes_per_lift);
   EXPECT_EQ(a.tube_mass_check.limits.max_off_whole, b.tube_mass_check.limits.max_off_whole);
   EXPECT_EQ(a.gripper_speed, b.gripper_speed);
   EXPECT_EQ(a.gripper_force, b.gripper_force);
@@ -152,7 +152,7 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.tube_mass_check.enabled = false;
   p.tube_mass_check.limits.window = 7;
   p.tube_mass_check.limits.min_lifts = 4;
-  p.tube_mass_check.limits.min_held_ratio = 0.4;
+  p.tube_mass_check.limits.max_tubes_per_lift = 4;
   p.tube_mass_check.limits.max_off_whole = 0.15;
   p.ft_samples = 9;
   p.max_plans_per_scan = 3;

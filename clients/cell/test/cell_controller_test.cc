@@ -489,7 +489,9 @@ TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
   EXPECT_EQ(result.attempts, 3u);
-  EXPECT_NE(result.message.find("max_attempts_per_tube = 3"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("max_attempts_per_tube = 3: grasp_failed, grasp_failed, grasp_failed)"),
+            std::string::npos)
+      << result.message;
   const std::vector<json> attempts = Records("attempt");
   ASSERT_EQ(attempts.size(), 3u);
   for (const json& a : attempts) EXPECT_EQ(a["result"], "grasp_failed");
@@ -497,6 +499,26 @@ TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
   EXPECT_EQ(end["reason"], "limit_reached");
   EXPECT_EQ(end["message"], result.message);
   EXPECT_TRUE(Records("safe_stop").empty());
+}
+
+TEST_F(CellControllerTest, AnAttemptLimitSaysWhatEachLiftSinceTheLastPickWeighed) {
+  // Tubes twice as heavy as tube.mass: every lift weighs two tubes, which fits a double pick, so no
+  // tube.mass doubt; the limit's message shows the same two tubes every time.
+  params.max_attempts_per_tube = 3;
+  for (int i = 0; i < 4; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.01), Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.02),
+                            Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.97),
+                            Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.06)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.attempts, 4u);
+  // The pick's lift is not among them: the list starts after it.
+  EXPECT_NE(result.message.find("(max_attempts_per_tube = 3: multiple 2.02 tubes, multiple 1.97 tubes, "
+                                "multiple 2.06 tubes)"),
+            std::string::npos)
+      << result.message;
+  EXPECT_EQ(result.tube_mass_doubts, 0u);
 }
 
 TEST_F(CellControllerTest, ScansWithoutPlanCountAsConsecutiveFailures) {

@@ -15,15 +15,41 @@ TEST(TubeMassCheck, LiftsOfAboutWholeTubesFit) {
   // rubber 5.32 (one off, so the window fits).
   EXPECT_FALSE(CheckTubeMass({0.93, 1.04, 0.97, 1.01, 0.99}, 0.110).has_value());
   EXPECT_FALSE(CheckTubeMass({1.98, 2.13, 3.0, 5.32, 5.42}, 0.055).has_value());
-  // Nothing held (a failed grasp reads about 0) is no evidence either way.
+  // Lifts that read about none between them: one whole tube in the window is enough.
   EXPECT_FALSE(CheckTubeMass({0.01, -0.02, 0.0, 1.01}, 0.110).has_value());
+}
+
+TEST(TubeMassCheck, LiftsTheGripperHeldThatWeighAboutNothingDoubtAMassTenTimesTooHigh) {
+  // The simulated cell with PVC tubes of 0.0055 kg and tube.mass 0.055 kg (`--sim-tube-mass 0.0055`):
+  // every lift read 0.05-0.12 tubes, Algorithm 3's "none", while the gripper held a tube.
+  const std::optional<TubeMassDoubt> d = CheckTubeMass({0.121, 0.103, 0.114}, 0.055);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_NEAR(d->mass_if_single, 0.055 * 0.114, 1e-12);
+  EXPECT_NE(d->message.find("0.10-0.12 times tube.mass (0.055 kg)"), std::string::npos) << d->message;
+  EXPECT_NE(d->message.find("the gripper held something each time"), std::string::npos) << d->message;
+  EXPECT_NE(d->message.find("would weigh 0.006 kg"), std::string::npos) << d->message;
+}
+
+TEST(TubeMassCheck, LiftsOfMoreTubesThanAGraspHoldsDoubtAMassTenTimesTooLow) {
+  // PVC tubes of 0.55 kg and tube.mass 0.055 kg: every lift read ten tubes.
+  const std::optional<TubeMassDoubt> d = CheckTubeMass({10.021, 10.014, 10.061}, 0.055);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_NEAR(d->mass_if_single, 0.055 * 10.021, 1e-12);
+  EXPECT_NE(d->message.find("none a whole number of tubes from 1 to 6"), std::string::npos) << d->message;
+  TubeMassCheckParams p;
+  p.max_tubes_per_lift = 12;  // a cell whose grasps can lift a dozen
+  EXPECT_FALSE(CheckTubeMass({10.021, 10.014, 10.061}, 0.055, p).has_value());
+  // Half the real mass is not seen: every lift weighs two whole tubes.
+  EXPECT_FALSE(CheckTubeMass({2.02, 2.01, 2.06, 1.97}, 0.055).has_value());
 }
 
 TEST(TubeMassCheck, TooFewLiftsAreNotJudged) {
   EXPECT_FALSE(CheckTubeMass({}, 0.110).has_value());
   EXPECT_FALSE(CheckTubeMass({1.36, 1.34}, 0.110).has_value());
-  EXPECT_FALSE(CheckTubeMass({1.36, 0.02, 1.34, 0.01}, 0.110).has_value());  // two that held something
-  EXPECT_TRUE(CheckTubeMass({1.36, 0.02, 1.34, 0.01, 1.31}, 0.110).has_value());
+  EXPECT_TRUE(CheckTubeMass({1.36, 1.34, 1.31}, 0.110).has_value());
+  TubeMassCheckParams p;
+  p.min_lifts = 4;
+  EXPECT_FALSE(CheckTubeMass({1.36, 1.34, 1.31}, 0.110, p).has_value());
 }
 
 TEST(TubeMassCheck, AMassAQuarterTooLowIsNamedWithTheMassTheLiftsSuggest) {
@@ -57,6 +83,9 @@ TEST(TubeMassCheck, BadInputsAreRefused) {
   EXPECT_THROW(CheckTubeMass({1.0}, 0.110, p), InvalidArgument);
   p = {};
   p.max_off_whole = 0.5;  // every ratio would fit
+  EXPECT_THROW(CheckTubeMass({1.0}, 0.110, p), InvalidArgument);
+  p = {};
+  p.max_tubes_per_lift = 0;
   EXPECT_THROW(CheckTubeMass({1.0}, 0.110, p), InvalidArgument);
 }
 
