@@ -23,6 +23,15 @@ const char* ResultName(int result) {
   return kNames[result];
 }
 
+/// What the attempts since the last pick came to, the most recent eight at most.
+std::string AttemptsSincePick(const std::vector<std::string>& since_pick) {
+  constexpr std::size_t kShown = 8;
+  const std::size_t n = since_pick.size();
+  if (n <= kShown) return fmt::format("{}", fmt::join(since_pick, ", "));
+  return fmt::format("{} earlier, then {}", n - kShown,
+                     fmt::join(since_pick.end() - kShown, since_pick.end(), ", "));
+}
+
 }  // namespace
 
 using detail::CallDevice;
@@ -222,14 +231,14 @@ std::optional<std::string> CellController::LimitReached(const RunState& run) con
   if (run.attempts_since_pick >= params_.max_attempts_per_tube)
     return fmt::format("{} attempts since the last pick (max_attempts_per_tube = {}: {})",
                        run.attempts_since_pick, params_.max_attempts_per_tube,
-                       fmt::join(run.since_pick, ", "));
+                       AttemptsSincePick(run.since_pick));
   if (run.result.attempts >= params_.max_attempts_per_bin)
     return fmt::format("{} attempts in this bin (max_attempts_per_bin = {})", run.result.attempts,
                        params_.max_attempts_per_bin);
   if (run.consecutive_failures >= params_.max_consecutive_failures)
     return fmt::format("{} consecutive failures (max_consecutive_failures = {}{}{})",
                        run.consecutive_failures, params_.max_consecutive_failures,
-                       run.since_pick.empty() ? "" : "; attempts: ", fmt::join(run.since_pick, ", "));
+                       run.since_pick.empty() ? "" : "; attempts: ", AttemptsSincePick(run.since_pick));
   return std::nullopt;
 }
 

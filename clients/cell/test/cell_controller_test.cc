@@ -521,6 +521,21 @@ TEST_F(CellControllerTest, AnAttemptLimitSaysWhatEachLiftSinceTheLastPickWeighed
   EXPECT_EQ(result.tube_mass_doubts, 0u);
 }
 
+TEST_F(CellControllerTest, AnAttemptLimitListsTheLastEightAttempts) {
+  params.max_attempts_per_tube = 10;
+  params.max_consecutive_failures = 20;
+  params.max_plans_per_scan = 1;
+  for (int i = 0; i < 10; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  for (int i = 0; i < 10; ++i) gripper.close_results.push_back(ClosedOnNothing());
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.attempts, 10u);
+  EXPECT_NE(result.message.find("(max_attempts_per_tube = 10: 2 earlier, then grasp_failed, grasp_failed, "
+                                "grasp_failed, grasp_failed, grasp_failed, grasp_failed, grasp_failed, "
+                                "grasp_failed)"),
+            std::string::npos)
+      << result.message;
+}
+
 TEST_F(CellControllerTest, ScansWithoutPlanCountAsConsecutiveFailures) {
   params.max_consecutive_failures = 2;
   for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({}, 1));
