@@ -236,9 +236,10 @@ std::optional<std::string> CellController::LimitReached(const RunState& run) con
     return fmt::format("{} attempts in this bin (max_attempts_per_bin = {})", run.result.attempts,
                        params_.max_attempts_per_bin);
   if (run.consecutive_failures >= params_.max_consecutive_failures)
-    return fmt::format("{} consecutive failures (max_consecutive_failures = {}{}{})",
-                       run.consecutive_failures, params_.max_consecutive_failures,
-                       run.since_pick.empty() ? "" : "; attempts: ", AttemptsSincePick(run.since_pick));
+    return fmt::format(
+        "{} consecutive failures (max_consecutive_failures = {}{}{})", run.consecutive_failures,
+        params_.max_consecutive_failures,
+        run.since_pick.empty() ? "" : "; since the last pick: ", AttemptsSincePick(run.since_pick));
   return std::nullopt;
 }
 
@@ -430,6 +431,11 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
   record["durations"]["attempt_wall_s"] = SecondsSince(scan.started);
   record["durations"]["attempt_device_s"] = DeviceNow() - scan.device_started;
   record["truth_after"] = Truth();
+  const std::size_t skipped = record["skipped_plans"].size();
+  run.since_pick.push_back(
+      nudge          ? fmt::format("no plan, nudged tube {}", nudge->tube_id)
+      : skipped == 0 ? std::string("no plan")
+                     : fmt::format("no plan ({} of {} skipped)", skipped, scan.response.plans_size()));
   if (sink_) sink_->Write(record);
   if (!nudge)
     spdlog::info("cell: round {} scan {}: no executable plan ({} plans, {} skipped)", round_, scan.index,

@@ -113,8 +113,9 @@ struct CellController::RunState {
   std::uint32_t attempts_since_pick = 0;
   std::uint32_t consecutive_failures = 0;
   std::uint32_t nudges_since_pick = 0;
-  /// What each attempt since the last pick came to ("multiple 2.02": the lift's outcome and tubes of
-  /// tube.mass; else the attempt's result), for the message of a limit.
+  /// What each attempt or scan without a plan since the last pick came to ("multiple 2.02 tubes": the
+  /// lift's outcome and tubes of tube.mass; "grasp_failed"; "no plan, nudged tube 3"), for the message
+  /// of a limit.
   std::vector<std::string> since_pick;
   std::optional<Attempt> active;
 };

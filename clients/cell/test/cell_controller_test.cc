@@ -543,7 +543,10 @@ TEST_F(CellControllerTest, ScansWithoutPlanCountAsConsecutiveFailures) {
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
   EXPECT_EQ(result.attempts, 0u);
-  EXPECT_NE(result.message.find("2 consecutive failures"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("2 consecutive failures (max_consecutive_failures = 2; since the last pick: "
+                                "no plan, no plan)"),
+            std::string::npos)
+      << result.message;
   const std::vector<json> records = Records("attempt");
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0]["result"], "no_plan");
@@ -622,6 +625,9 @@ TEST_F(CellControllerTest, NudgesStopAtTheirLimitAndScansThenOnlyRescan) {
   const CellRunResult limited = Run();
   EXPECT_EQ(limited.reason, CellStopReason::kLimitReached);
   EXPECT_EQ(limited.nudges, 1u);
+  EXPECT_NE(limited.message.find("(max_consecutive_failures = 1; since the last pick: no plan, nudged tube "),
+            std::string::npos)
+      << limited.message;
 }
 
 TEST_F(CellControllerTest, NudgeDisabledOrWithoutGeometryIsANoPlanScan) {
