@@ -69,7 +69,12 @@ std::string DescribeAttemptBriefly(const nlohmann::json& record) {
   if (const auto a = record.find("analysis"); a != record.end() && a->is_object()) {
     return fmt::format("{} {:.2f} tubes", a->value("outcome", ""), a->value("tube_ratio", 0.0));
   }
-  return record.value("result", "unfinished");
+  const std::string result = record.value("result", "unfinished");
+  if (result == "nudge") return fmt::format("no plan, nudged tube {}", record["nudge"].value("tube", 0u));
+  if (result != "no_plan") return result;
+  const std::size_t skipped = record.value("skipped_plans", nlohmann::json::array()).size();
+  return skipped == 0 ? std::string("no plan")
+                      : fmt::format("no plan ({} of {} skipped)", skipped, record.value("plans", 0));
 }
 
 nlohmann::json ResolutionJson(int available) {

@@ -50,8 +50,9 @@ nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Ve
 /// {"outcome", "estimated_count", "tube_ratio", "held_weight", "tube_weight", "motions"}.
 nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis);
 
-/// An attempt in a few words from its record: the lift's outcome and tubes of tube.mass ("multiple
-/// 2.02 tubes"), or the attempt's result when nothing was lifted ("grasp_failed").
+/// An attempt (or a scan without a plan) in a few words from its record: the lift's outcome and tubes
+/// of tube.mass ("multiple 2.02 tubes"), the attempt's result when nothing was lifted ("grasp_failed"),
+/// or "no plan" ("no plan (3 of 5 skipped)", "no plan, nudged tube 3").
 std::string DescribeAttemptBriefly(const nlohmann::json& record);
 
 /// {"available", "used": 0, "succeeded": false}.

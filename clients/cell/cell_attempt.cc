@@ -202,10 +202,10 @@ v1::AnalyzeWrenchResponse CellController::AnalyzeLift(const devices::WrenchReadi
 /// Whether the cell's recent lifts still fit tube.mass (CheckTubeMass): the doubt goes into the attempt's
 /// record and, the first time, the log. Algorithm 3's decision stands either way.
 void CellController::CheckLiftWeights(double tube_ratio, Attempt& attempt) {
-  constexpr std::size_t kKept = 64;
-  lift_ratios_.push_back(tube_ratio);
-  if (lift_ratios_.size() > kKept) lift_ratios_.erase(lift_ratios_.begin());
   if (!params_.tube_mass_check.enabled) return;
+  // CheckTubeMass reads the last `window` lifts only.
+  lift_ratios_.push_back(tube_ratio);
+  if (lift_ratios_.size() > params_.tube_mass_check.limits.window) lift_ratios_.erase(lift_ratios_.begin());
   const std::optional<TubeMassDoubt> doubt =
       CheckTubeMass(lift_ratios_, cell_.tube.mass, params_.tube_mass_check.limits);
   if (!doubt) return;

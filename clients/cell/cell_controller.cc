@@ -431,11 +431,7 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
   record["durations"]["attempt_wall_s"] = SecondsSince(scan.started);
   record["durations"]["attempt_device_s"] = DeviceNow() - scan.device_started;
   record["truth_after"] = Truth();
-  const std::size_t skipped = record["skipped_plans"].size();
-  run.since_pick.push_back(
-      nudge          ? fmt::format("no plan, nudged tube {}", nudge->tube_id)
-      : skipped == 0 ? std::string("no plan")
-                     : fmt::format("no plan ({} of {} skipped)", skipped, scan.response.plans_size()));
+  run.since_pick.push_back(DescribeAttemptBriefly(record));
   if (sink_) sink_->Write(record);
   if (!nudge)
     spdlog::info("cell: round {} scan {}: no executable plan ({} plans, {} skipped)", round_, scan.index,

@@ -483,7 +483,8 @@ class CellController {
   std::uint32_t round_ = 0;
   /// Codes of the planner's modeling warnings already logged (PlanPick logs each once).
   std::set<std::string> planner_warnings_seen_;
-  /// tube_ratio of every lift analysed (the most recent 64), oldest first: CheckTubeMass's input.
+  /// tube_ratio of the most recent lifts analysed (tube_mass_check.limits.window of them), oldest
+  /// first: CheckTubeMass's input.
   std::vector<double> lift_ratios_;
   bool tube_mass_doubt_said_ = false;
   /// A stop was requested (RequestStop); stop_why_ (under stop_mutex_) is set before it.

@@ -86,7 +86,7 @@ void DescribeFields(Visit& v, CellFrameCheckParams& c) {
 template <typename Visit>
 void DescribeFields(Visit& v, LiftWeightCheckParams& c) {
   v("enabled", c.enabled, "warn when the lifts' weights fit no whole number of tubes of tube.mass");
-  v("window", c.limits.window, "the most recent lifts that held something, judged together");
+  v("window", c.limits.window, "the most recent lifts, judged together");
   v("min_lifts", c.limits.min_lifts, "of them, at least this many");
   v("max_tubes_per_lift", c.limits.max_tubes_per_lift, "the most tubes one lift is believed to hold");
   v("max_off_whole", c.limits.max_off_whole, "tubes' worth a lift may lie from a whole number and fit");

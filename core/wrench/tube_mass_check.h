@@ -20,7 +20,7 @@ namespace tubepick {
 /// than a grasp lifts (a mass ten times too low). A mass off by a small whole factor (half the real
 /// one) is not seen this way: every lift then weighs two tubes.
 struct TubeMassCheckParams {
-  /// The most recent lifts that held something looked at ...
+  /// The most recent lifts looked at ...
   std::uint32_t window = 5;
   /// ... of which at least this many are needed to judge.
   std::uint32_t min_lifts = 3;
@@ -36,7 +36,7 @@ struct TubeMassCheckParams {
 
 /// Lifts that do not fit tube.mass.
 struct TubeMassDoubt {
-  /// The lifts judged (the most recent that held something) and their tube ratios' range and median.
+  /// The lifts judged (the most recent) and their tube ratios' range and median.
   std::uint32_t lifts = 0;
   double min_ratio = 0.0;
   double max_ratio = 0.0;
