@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "clients/cell/attempt_record.h"
 #include "clients/cli/inputs/cli_inputs.h"
 #include "core/common/errors.h"
 #include "wire/proto_convert.h"
@@ -27,10 +28,19 @@ CellConfig CellOf(const v1::CellDescription& d, const CellConfig& fallback) {
   return cell;
 }
 
+// A record's whole number at `key`, or `fallback` when it is missing or not a number (a scan
+// without a plan has "attempt": null).
+int Count(const nlohmann::json& r, const char* key, int fallback) {
+  const auto it = r.find(key);
+  return it != r.end() && it->is_number() ? it->get<int>() : fallback;
+}
+
 std::string AttemptNote(const nlohmann::json& r) {
+  if (!r.contains("attempt") || !r["attempt"].is_number())  // a scan without a plan, perhaps a nudge
+    return cell::DescribeAttemptBriefly(r);
   std::string note = fmt::format(
-      "attempt {}: plan #{} (tube {}, {}) → {}", r.value("attempt", 0), r.value("plan_rank", 0) + 1,
-      r.value("tube", 0), r.value("trajectory_kind", std::string("-")), r.value("result", std::string("-")));
+      "attempt {}: plan #{} (tube {}, {}) → {}", Count(r, "attempt", 0), Count(r, "plan_rank", 0) + 1,
+      Count(r, "tube", 0), r.value("trajectory_kind", std::string("-")), r.value("result", std::string("-")));
   if (r.contains("analysis") && r["analysis"].is_object() && r["analysis"].contains("outcome"))
     note += fmt::format(", lifted: {}", r["analysis"]["outcome"].get<std::string>());
   if (r.contains("resolution") && r["resolution"].is_object() && r["resolution"].value("used", 0) > 0)
@@ -90,7 +100,9 @@ void RoundViewRecorder::Annotate(const nlohmann::json& record) {
   viewer::ViewFrame& last = frames_.back();
   const std::string type = record.value("type", std::string());
   if (type == "attempt") {
-    if (record.contains("plan_rank") && record["plan_rank"].is_number())
+    // A scan without a plan records plan_rank 0 with "attempt": null: no plan was chosen.
+    if (record.contains("attempt") && record["attempt"].is_number() && record.contains("plan_rank") &&
+        record["plan_rank"].is_number())
       last.chosen_plan = record["plan_rank"].get<int>();
     last.note = AttemptNote(record);
   } else if (type == "safe_stop") {

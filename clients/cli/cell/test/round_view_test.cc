@@ -121,5 +121,44 @@ TEST(RoundViewRecorder, APageStepsThroughTheRoundsScansWithThePickAndItsOutcome)
   fs::remove_all(dir);
 }
 
+TEST(RoundViewRecorder, AScanWithoutAPlanNotesTheNudgeAndChoosesNoPlan) {
+  // The record the controller writes for a scan without a plan: "attempt" is null. The page's note
+  // once read it as a number and threw, which stopped the cell (a safe stop with nothing held).
+  const fs::path dir = fs::temp_directory_path() / "tubepick_round_view_nudge_test";
+  fs::remove_all(dir);
+  QueuePlanner planner;
+  planner.answers = {{Plans(1, 0)}, {Plans(1, 2)}};
+  cell::MemoryRecordSink memory;
+  RoundViewRecorder view(planner, memory, dir.string(), 100, ToolParams{});
+
+  view.PlanPick(Request(100), std::chrono::seconds(1));
+  EXPECT_NO_THROW(view.Write({{"type", "attempt"},
+                              {"round", 0},
+                              {"attempt", nullptr},
+                              {"plan_rank", 0},
+                              {"plans", 0},
+                              {"skipped_plans", nlohmann::json::array()},
+                              {"result", "nudge"},
+                              {"nudge", {{"tube", 3}}}}));
+  view.PlanPick(Request(100), std::chrono::seconds(1));
+  view.Write({{"type", "attempt"},
+              {"round", 0},
+              {"attempt", nullptr},
+              {"plan_rank", 0},
+              {"plans", 2},
+              {"skipped_plans", nlohmann::json::array({{{"rank", 0}}, {{"rank", 1}}})},
+              {"result", "no_plan"}});
+  view.Write({{"type", "end"}, {"round", 0}, {"message", "attempt limit"}});
+
+  EXPECT_EQ(memory.records().size(), 3u);
+  const nlohmann::json data = PageData(view.pages().at(0));
+  ASSERT_EQ(data["frames"].size(), 2u);
+  EXPECT_EQ(data["frames"][0]["note"], "no plan, nudged tube 3");
+  EXPECT_FALSE(data["frames"][0].contains("chosen_plan"));
+  EXPECT_EQ(data["frames"][1]["note"], "no plan (2 of 2 skipped)");
+  EXPECT_FALSE(data["frames"][1].contains("chosen_plan"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tubepick::cli
