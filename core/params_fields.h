@@ -216,6 +216,8 @@ template <typename Visit>
 void DescribeFields(Visit& v, ClassificationParams& p) {
   v("length_tolerance", p.length_tolerance);
   v("junction_gap", p.junction_gap);
+  v("short_tubes_last_resort", p.short_tubes_last_resort,
+    "beyond the thesis: when every tube is too short, plan them anyway (unsure or simulated)");
 }
 
 template <typename Visit>

@@ -60,6 +60,7 @@ v1::PlanningCounts CountsToProto(const PlanningCounts& c) {
   pc.set_rejected_fingers(c.rejected_fingers);
   pc.set_rejected_approach(c.rejected_approach);
   pc.set_non_occluded_lain_on(c.non_occluded_lain_on);
+  pc.set_short_tubes_planned(c.short_tubes_planned);
   return pc;
 }
 

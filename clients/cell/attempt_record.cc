@@ -19,6 +19,8 @@ nlohmann::json AttemptRecord(const AttemptRecordHead& head, const v1::PlanPickRe
                         {"bin_empty", response.bin_empty()},
                         {"used_simulation", response.used_simulation()},
                         {"truth_before", head.truth_before}};
+  // Every tube of the scan was too short for a whole one; they were planned as a last resort.
+  if (response.counts().short_tubes_planned()) record["short_tubes_planned"] = response.counts().too_short();
   // The modeling's warnings about the cell's inputs (e.g. a tube.length shorter than the scan shows).
   if (response.modeling().warnings_size() > 0) {
     nlohmann::json& warnings = record["planner_warnings"] = nlohmann::json::array();

@@ -18,6 +18,11 @@ struct ClassificationParams {
   /// it is longer than the branch's radius plus this, metres: at a junction seen whole, the
   /// branch's first cylinder starts about one radius from the node (on the other branch's axis).
   double junction_gap = 0.02;
+  /// Beyond the thesis: when every modeled tube is shorter than the minimum, plan them anyway, as
+  /// plans that need luck (simulated where an evaluator is given, else unsure). The thesis plans
+  /// nothing then, and a bin whose last tube is partly hidden (a tree propped against a wall, an end
+  /// under its own branch) is never emptied.
+  bool short_tubes_last_resort = true;
 };
 
 /// Cylinder indices [begin, end) of a tube: a section, or the cylinders a grasp may use.

@@ -50,6 +50,10 @@ std::int8_t CloudCollision(const Grasp& grasp, const RawCloudIndex& raw, const P
   return 0;
 }
 
+// A non-occluded tube's upward lift is sure when no modeled tube lies on it and the tube is not
+// too short (a short one is planned only as a last resort: a part of it is hidden).
+bool IsSure(const TubeClass& cls) { return cls.lying_on.empty() && !cls.too_short; }
+
 struct Candidate {
   std::uint32_t trajectory = 0;  // index into the stage's trajectories
   std::uint32_t grasp = 0;       // index into TubeGrasps::grasps of the trajectory's tube
@@ -91,6 +95,8 @@ struct PlanningContext {
   std::vector<TubeGrasps> tube_grasps;
   // Trajectories of the stages before, so that trajectory indices stay unique in one answer.
   std::uint32_t trajectories_before = 0;
+  // Every tube is too short and classification.short_tubes_last_resort: plan them anyway.
+  bool short_tubes = false;
 };
 
 // Trajectories of the stage's candidate tubes (thesis §5.2.3.1).
@@ -99,7 +105,7 @@ std::vector<Trajectory> StageTrajectories(const PlanningContext& ctx, Occlusion 
   std::vector<Trajectory> trajectories;
   for (std::size_t t = 0; t < result.tubes.size(); ++t) {
     const TubeClass& cls = result.classes[t];
-    if (cls.too_short || cls.occlusion != stage) continue;
+    if ((cls.too_short && !ctx.short_tubes) || cls.occlusion != stage) continue;
     std::vector<Trajectory> own =
         SynthesizeTrajectories(static_cast<std::uint32_t>(t), result.tubes[t], cls, ctx.cell.tube.radius,
                                ctx.zone, ctx.params.trajectories);
@@ -164,8 +170,7 @@ std::vector<bool> TrajectoriesToSimulate(const PlanningContext& ctx, Occlusion s
   if (stage == Occlusion::kNone) {
     if (!ctx.params.certainty.safe_first) return simulate;
     for (const Candidate& c : viable) {
-      if (result.classes[trajectories[c.trajectory].tube_index].lying_on.empty())
-        return simulate;  // a sure plan
+      if (IsSure(result.classes[trajectories[c.trajectory].tube_index])) return simulate;
     }
   }
   for (const Candidate& c : viable) simulate[c.trajectory] = true;
@@ -241,9 +246,9 @@ void PlanStage(PlanningContext& ctx, Occlusion stage, PickPlanResult* result, St
     plan.escape_direction = trajectory.escape_direction;
     plan.trajectory_index = first_index + c.trajectory;
     plan.displacement = displacement[c.trajectory];
-    plan.certainty = plan.displacement                                   ? PlanCertainty::kSimulated
-                     : stage == Occlusion::kNone && cls.lying_on.empty() ? PlanCertainty::kSure
-                                                                         : PlanCertainty::kUnsure;
+    plan.certainty = plan.displacement                          ? PlanCertainty::kSimulated
+                     : stage == Occlusion::kNone && IsSure(cls) ? PlanCertainty::kSure
+                                                                : PlanCertainty::kUnsure;
     plan.costs = PlanCost(plan.grasp, tube, ctx.max_z, plan.displacement, ctx.params.cost);
     result->plans.push_back(std::move(plan));
   }
@@ -381,19 +386,23 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
     }
   }
   // Which free tubes another tube lies on (their plans are not sure): part of classification.
+  const bool short_tubes =
+      counts.tubes > 0 && counts.too_short == counts.tubes && params.classification.short_tubes_last_resort;
   for (std::size_t t = 0; t < result.tubes.size(); ++t) {
     TubeClass& cls = result.classes[t];
-    if (cls.too_short || cls.occlusion != Occlusion::kNone) continue;
+    if ((cls.too_short && !short_tubes) || cls.occlusion != Occlusion::kNone) continue;
     cls.lying_on = TubesLyingOn(result.tubes, t, params.certainty);
     if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
   }
   timer.Add("classification", t0);
-  if (counts.too_short == counts.tubes) {
+  if (counts.too_short == counts.tubes && !short_tubes) {
     result.total_seconds = SecondsSince(start);
     return result;
   }
 
   PlanningContext ctx(modeling, cell, params, evaluator, seed, stop);
+  ctx.short_tubes = short_tubes;
+  counts.short_tubes_planned = short_tubes;
   ctx.max_z = MaxHeight(modeling, result.tubes);
   ctx.zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
   ctx.tube_grasps.resize(result.tubes.size());

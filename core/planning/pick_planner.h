@@ -53,6 +53,9 @@ struct PlanningCounts {
   std::uint32_t tubes = 0;
   /// Rejected by the minimum-length filter.
   std::uint32_t too_short = 0;
+  /// Every modeled tube was too short and planning.classification.short_tubes_last_resort planned
+  /// them anyway: every plan needs luck (kUnsure, or kSimulated with an evaluator).
+  bool short_tubes_planned = false;
   /// Occlusion classes among the tubes that passed the length filter.
   std::uint32_t non_occluded = 0;
   std::uint32_t weakly_occluded = 0;

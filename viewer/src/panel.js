@@ -113,9 +113,9 @@ function countsSection(m) {
     out.push(el('h2', {}, 'Candidates rejected per filter'), kvTable([
       ['grasp candidates', n('graspCandidates')], ['rejected: section', n('rejectedSection')],
       ['rejected: workspace', n('rejectedWorkspace')], ['rejected: tool', n('rejectedTool')],
-      ['rejected: fingers', n('rejectedFingers')]], 'counts'));
+      ['rejected: fingers', n('rejectedFingers')], ['rejected: approach', n('rejectedApproach')]], 'counts'));
     out.push(el('h2', {}, 'Tubes and trajectories'), kvTable([
-      ['tubes', n('tubes')], ['too short', n('tooShort')], ['non-occluded', n('nonOccluded')],
+      ['tubes', n('tubes')], ['too short', c.shortTubesPlanned ? `${n('tooShort')}, every one: planned as a last resort` : n('tooShort')], ['non-occluded', n('nonOccluded')],
       ['weakly occluded', n('weaklyOccluded')], ['strongly occluded', n('stronglyOccluded')],
       ['trajectories', n('trajectories')], ['trajectories simulated', n('simulatedTrajectories')]], 'tube-counts'));
   }

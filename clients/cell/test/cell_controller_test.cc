@@ -161,11 +161,28 @@ TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   EXPECT_EQ(a["resolution"]["used"], 0);
   EXPECT_EQ(a["result"], "picked");
   EXPECT_FALSE(a.contains("planner_warnings"));
+  EXPECT_FALSE(a.contains("short_tubes_planned"));
   EXPECT_EQ(DescribePlannerWarnings(result), "");
   EXPECT_DOUBLE_EQ(a["grasp"]["tcp_pose"]["position"][0].get<double>(), p_Bin_grasp.x());
   EXPECT_GE(a["durations"]["planning_wall_s"].get<double>(), 0.0);
   EXPECT_DOUBLE_EQ(a["durations"]["planning_server_s"].get<double>(), 0.5);
   EXPECT_EQ(Records("end").at(0)["picks"], 1);
+}
+
+TEST_F(CellControllerTest, APlanOfATubeTooShortForAWholeOneIsRecordedAsALastResort) {
+  // Every tube of the scan was shorter than a whole one (a tree half hidden against a wall): the
+  // planner planned them anyway and says so; the record keeps how many were too short.
+  auto answer = Plans({MakePlan(4, p_Bin_grasp)}, 1);
+  answer.response.mutable_counts()->set_too_short(1);
+  answer.response.mutable_counts()->set_short_tubes_planned(true);
+  planner.plan_answers.push_back(answer);
+  ft.readings = {Reading(0.10), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+
+  EXPECT_EQ(Run().picks, 1u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 1u);
+  EXPECT_EQ(attempts[0]["short_tubes_planned"], 1);
 }
 
 TEST_F(CellControllerTest, ThePlannersWarningsAboutTheCellAreInEveryAttemptRecord) {

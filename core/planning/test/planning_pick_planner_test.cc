@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -220,6 +221,46 @@ TEST(PickPlanner, TooShortTubesAreObstaclesOnly) {
   EXPECT_EQ(evaluator.calls, 1);
   EXPECT_EQ(evaluator.tubes_seen.size(), 2u);
   for (const PickPlan& p : r.plans) EXPECT_EQ(p.tube_id, 1u);
+}
+
+TEST(PickPlanner, WhenEveryTubeIsTooShortTheyArePlannedAsALastResortThatNeedsLuck) {
+  // Expected length 0.5, tolerance 0.15: both tubes (0.30 m, free; 0.25 m, free) are too short.
+  // The thesis plans nothing, and a bin whose last tube is partly hidden is never emptied.
+  const std::vector<Tube> tubes = {MakeTube(0, {FlatCylinder(-0.15, 0.2, 0.15, 0.2, 5)}),
+                                   MakeTube(1, {FlatCylinder(-0.15, -0.1, 0.10, -0.1, 6)})};
+  PlanningParams thesis;
+  thesis.classification.short_tubes_last_resort = false;
+  const PickPlanResult none = PlanPick(Model(tubes), CellConfig{}, thesis, nullptr, 0);
+  EXPECT_TRUE(none.plans.empty());
+  EXPECT_FALSE(none.counts.short_tubes_planned);
+  EXPECT_FALSE(none.bin_empty);
+
+  // Without an evaluator: plans of both tubes, every one unsure (never "sure": a part is hidden).
+  const PickPlanResult unsure = PlanPick(Model(tubes), CellConfig{}, PlanningParams{}, nullptr, 0);
+  EXPECT_TRUE(unsure.counts.short_tubes_planned);
+  EXPECT_EQ(unsure.counts.too_short, 2u);
+  ASSERT_FALSE(unsure.plans.empty());
+  std::set<std::uint32_t> planned;
+  for (const PickPlan& p : unsure.plans) {
+    EXPECT_EQ(p.certainty, PlanCertainty::kUnsure);
+    planned.insert(p.tube_id);
+  }
+  EXPECT_EQ(planned, (std::set<std::uint32_t>{0u, 1u}));
+  EXPECT_EQ(unsure.planned_class, Occlusion::kNone);
+
+  // With an evaluator: their upward lifts are simulated, as a lain-on free tube's are.
+  FakeEvaluator evaluator(ScriptedDisplacement);
+  const PickPlanResult simulated = PlanPick(Model(tubes), CellConfig{}, PlanningParams{}, &evaluator, 0);
+  EXPECT_EQ(evaluator.calls, 1);
+  ASSERT_FALSE(simulated.plans.empty());
+  for (const PickPlan& p : simulated.plans) EXPECT_EQ(p.certainty, PlanCertainty::kSimulated);
+
+  // One tube long enough: the short one stays an obstacle only.
+  const std::vector<Tube> one_whole = {tubes[0], MakeTube(1, {FlatCylinder(-0.2, -0.1, 0.2, -0.1, 6)})};
+  const PickPlanResult whole = PlanPick(Model(one_whole), CellConfig{}, PlanningParams{}, nullptr, 0);
+  EXPECT_FALSE(whole.counts.short_tubes_planned);
+  ASSERT_FALSE(whole.plans.empty());
+  for (const PickPlan& p : whole.plans) EXPECT_EQ(p.tube_id, 1u);
 }
 
 TEST(PickPlanner, BinEmpty) {
