@@ -1,6 +1,7 @@
 #include "clients/cli/cell/round_view.h"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <filesystem>
 
@@ -74,9 +75,22 @@ viewer::ViewFrame RoundViewRecorder::FrameOf(const v1::PlanPickRequest& request)
   return frame;
 }
 
+template <typename F>
+bool RoundViewRecorder::Guarded(const char* what, F&& f) {
+  try {
+    f();
+    return true;
+  } catch (const std::exception& e) {
+    spdlog::error("cell --view: {} failed, the round page misses it (the cell goes on): {}", what, e.what());
+    return false;
+  }
+}
+
 v1::PlanPickResponse RoundViewRecorder::PlanPick(const v1::PlanPickRequest& request,
                                                  std::chrono::milliseconds deadline) {
-  viewer::ViewFrame frame = FrameOf(request);
+  viewer::ViewFrame frame;
+  if (!Guarded("the scan's cloud", [&] { frame = FrameOf(request); }))
+    frame.label = fmt::format("scan {}", frames_.size() + 1);
   try {
     v1::PlanPickResponse response = planner_.PlanPick(request, deadline);
     frame.plan = response;
@@ -135,10 +149,11 @@ void RoundViewRecorder::WriteRound(const nlohmann::json& end) {
 
 void RoundViewRecorder::Write(const nlohmann::json& record) {
   next_.Write(record);
+  // The page is a diagnostic: whatever goes wrong with it must not stop the cell.
   if (record.value("type", std::string()) == "end")
-    WriteRound(record);
+    Guarded("writing the round page", [&] { WriteRound(record); });
   else
-    Annotate(record);
+    Guarded("noting the record on the page", [&] { Annotate(record); });
 }
 
 }  // namespace tubepick::cli

@@ -14,7 +14,8 @@ namespace tubepick::cli {
 /// `tubepick cell --view DIR`: one 3-D page per round (DIR/round_NNN.html) that steps through the
 /// round's scans: each PlanPick's cloud (thinned, bin frame) and answer or error, the plan the cell
 /// executed and what came of it (the attempt, safe-stop and end records). It sits between the
-/// controller and its planner and record sink, passing everything on unchanged.
+/// controller and its planner and record sink, passing everything on unchanged; a failure of its own
+/// (a page that cannot be written) is logged, never thrown into the controller.
 class RoundViewRecorder final : public cell::PlannerClient, public cell::RecordSink {
  public:
   /// `planner` and `next` must outlive the recorder. @throws InvalidArgument when `directory`
@@ -35,6 +36,9 @@ class RoundViewRecorder final : public cell::PlannerClient, public cell::RecordS
 
  private:
   viewer::ViewFrame FrameOf(const v1::PlanPickRequest& request);
+  /// Runs f; an exception is logged and swallowed (false): the page is a diagnostic, the cell goes on.
+  template <typename F>
+  bool Guarded(const char* what, F&& f);
   void Annotate(const nlohmann::json& record);
   void WriteRound(const nlohmann::json& end);
 

@@ -160,5 +160,23 @@ TEST(RoundViewRecorder, AScanWithoutAPlanNotesTheNudgeAndChoosesNoPlan) {
   fs::remove_all(dir);
 }
 
+TEST(RoundViewRecorder, APageThatCannotBeWrittenDoesNotStopTheCell) {
+  // The directory is gone when the round ends (a file stands in its place): the page is lost and
+  // logged, the end record still reaches the controller's sink, and nothing is thrown.
+  const fs::path dir = fs::temp_directory_path() / "tubepick_round_view_unwritable_test";
+  fs::remove_all(dir);
+  QueuePlanner planner;
+  planner.answers = {{Plans(1, 1)}};
+  cell::MemoryRecordSink memory;
+  RoundViewRecorder view(planner, memory, dir.string(), 100, ToolParams{});
+  view.PlanPick(Request(10), std::chrono::seconds(1));
+  fs::remove_all(dir);
+  std::ofstream(dir.string()) << "not a directory";
+  EXPECT_NO_THROW(view.Write({{"type", "end"}, {"round", 0}, {"message", "bin empty"}}));
+  EXPECT_EQ(memory.records().size(), 1u);
+  EXPECT_TRUE(view.pages().empty());
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace tubepick::cli
