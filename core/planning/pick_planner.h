@@ -112,7 +112,8 @@ bool IsBinEmpty(const ModelingResult& modeling, const PlanningParams& params);
 RawRegion RawRegionForPlanning(const PlanningParams& params, const BinConfig& bin);
 
 /// Plans a pick (ARCHITECTURE.md "How a plan request flows", thesis §5.2.2–§5.2.4):
-/// 1. classify the modeled tubes (length filter, occlusion);
+/// 1. classify the modeled tubes (length filter, occlusion); when every tube is too short and
+///    classification.short_tubes_last_resort, they are planned anyway, never as sure plans;
 /// 2. candidates in stages, stopping at the first stage that yields a viable grasp:
 ///    non-occluded tubes (upward trajectory, T_cost 0, no simulation); then weakly occluded
 ///    tubes (upward + two escapes); then, if strongly_occluded_candidates, strongly occluded
