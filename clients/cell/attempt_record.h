@@ -38,8 +38,8 @@ nlohmann::json PlanningDurationsJson(double planning_wall_s, double planning_ser
 /// Adds the plan's tube, trajectory_kind, cost and simulated_displacement to `record`.
 void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan);
 
-/// {"rank", "tube", "check", "reason"}: one entry of skipped_plans (check: "cell_frame",
-/// "robot_limits", "tool_clearance").
+/// {"rank", "tube", "check", "reason"}: one entry of skipped_plans (check: "failed_grasp",
+/// "cell_frame", "robot_limits", "tool_clearance").
 nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& check,
                                const std::string& reason);
 

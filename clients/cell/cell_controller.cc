@@ -310,7 +310,9 @@ std::uint32_t CellController::TryPlans(PlannedScan& scan, RunState& run) {
   for (int rank = 0; rank < scan.response.plans_size() && executed < params_.max_plans_per_scan; ++rank) {
     if (executed > 0 && LimitReached(run)) break;
     const v1::PickPlan& plan = scan.response.plans(rank);
-    if (const std::optional<PlanSkip> skip = ExecutionProblem(scan.response, rank)) {
+    std::optional<PlanSkip> skip = RepeatsFailedGrasp(plan, run);
+    if (!skip) skip = ExecutionProblem(scan.response, rank);
+    if (skip) {
       spdlog::debug("cell: plan {} (tube {}) skipped: {}", rank, plan.tube_id(), skip->reason);
       scan.skipped.push_back(SkippedPlanJson(rank, plan.tube_id(), skip->check, skip->reason));
       if (skip->check == "cell_frame" && scan.cell_mismatches++ == 0) scan.first_cell_mismatch = skip->reason;
@@ -364,6 +366,7 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   record["truth_after"] = Truth();
   CountAttemptWrench(attempt, run.result);
   run.since_pick.push_back(DescribeAttemptBriefly(record));
+  RememberFailedGrasp(outcome, record, run);
   if (sink_) sink_->Write(record);
   spdlog::info("cell: round {} attempt {}: tube {} {} -> {}", round_, run.result.attempts,
                record.value("tube", 0u), record.value("trajectory_kind", ""),
@@ -380,12 +383,41 @@ void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& r
   }
 }
 
+/// A grasp that closed on nothing or lifted nothing leaves the bin as it was: remember where.
+void CellController::RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run) {
+  if (outcome != AttemptResult::kNone && outcome != AttemptResult::kGraspFailed) return;
+  const auto grasp = record.find("grasp");
+  if (grasp == record.end() || !grasp->contains("tcp_pose")) return;
+  const nlohmann::json& p = (*grasp)["tcp_pose"]["position"];
+  run.failed_grasps.push_back({Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()),
+                               record.value("attempt", 0u), record.value("result", std::string())});
+}
+
+/// The plan grasps within failed_grasp_radius of a grasp that failed since the last pick.
+std::optional<CellController::PlanSkip> CellController::RepeatsFailedGrasp(const v1::PickPlan& plan,
+                                                                           const RunState& run) const {
+  if (params_.failed_grasp_radius <= 0.0) return std::nullopt;
+  const Eigen::Vector3d p_Bin_grasp = FromProto(plan.grasp().tcp_pose().position());
+  for (const RunState::FailedGrasp& failed : run.failed_grasps) {
+    const double distance = (p_Bin_grasp - failed.p_Bin_grasp).norm();
+    if (distance <= params_.failed_grasp_radius)
+      return PlanSkip{
+          "failed_grasp",
+          fmt::format("{:.3f} m from the grasp of attempt {} ({}) at ({:.3f}, {:.3f}, {:.3f}) m "
+                      "(failed_grasp_radius {:.3f} m): the bin is as it was then",
+                      distance, failed.attempt, failed.result, failed.p_Bin_grasp.x(), failed.p_Bin_grasp.y(),
+                      failed.p_Bin_grasp.z(), params_.failed_grasp_radius)};
+  }
+  return std::nullopt;
+}
+
 bool CellController::CountAttempt(AttemptResult outcome, RunState& run) {
   if (outcome == AttemptResult::kLost) ++run.result.lost;
   if (outcome == AttemptResult::kPicked) {
     ++run.result.picks;
     run.attempts_since_pick = 0;
     run.since_pick.clear();
+    run.failed_grasps.clear();
     run.consecutive_failures = 0;
     run.nudges_since_pick = 0;
     return false;

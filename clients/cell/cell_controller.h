@@ -228,7 +228,9 @@ nlohmann::json DryRunJson(const DryRunResult& dry);
 /// outside its bin, a place pose away from its place frame: a planner configured with another cell
 /// or in millimetres), that the arm cannot reach (Robot::Limits: pre-grasp, grasp, lift waypoints,
 /// placement) or the tool cannot execute without touching the bin (ToolClearanceProblem) are
-/// skipped before any motion and listed in the next record's skipped_plans ({rank, tube, check:
+/// skipped before any motion, and so are plans that grasp within failed_grasp_radius of a grasp that
+/// closed on or lifted nothing since the last pick (the bin is as it was: the same grasp fails the
+/// same way); all are listed in the next record's skipped_plans ({rank, tube, check: "failed_grasp" |
 /// "cell_frame" | "robot_limits" | "tool_clearance", reason}); when every plan of a scan was skipped
 /// as not fitting the cell, its "no_plan" record says so (cell_mismatch) and no nudge is tried; a scan
 /// without an executable plan is a "no_plan" record and a rescan — or, when the planner modeled a tube lying
@@ -311,7 +313,8 @@ class CellController {
   struct TubeLost;       ///< thrown inside an attempt when the held tube is gone
   struct StopRequested;  ///< thrown at a state or a motion after RequestStop
   struct StopCause;      ///< why a run ends in the safe stop: a fault or the operator
-  /// Why a plan is skipped: which check ("cell_frame", "robot_limits", "tool_clearance") and why.
+  /// Why a plan is skipped: which check ("failed_grasp", "cell_frame", "robot_limits",
+  /// "tool_clearance") and why.
   struct PlanSkip {
     std::string check;
     std::string reason;
@@ -337,6 +340,10 @@ class CellController {
   static void CountAttemptWrench(const Attempt& attempt, CellRunResult& result);
   /// Counts the attempt's outcome; true when the next plan of the same scan may be tried.
   bool CountAttempt(AttemptResult outcome, RunState& run);
+  /// Keeps the grasp of an attempt that closed on or lifted nothing (params.failed_grasp_radius).
+  void RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run);
+  /// "failed_grasp" when the plan's grasp point is within failed_grasp_radius of such a grasp.
+  std::optional<PlanSkip> RepeatsFailedGrasp(const v1::PickPlan& plan, const RunState& run) const;
   /// A scan without an executable plan: a "no_plan" record, or a nudge and its record.
   void NoExecutablePlan(PlannedScan& scan, RunState& run);
   std::optional<NudgePlan> PlanNudgeIfAllowed(const v1::PlanPickResponse& response,

@@ -92,6 +92,10 @@ void CellControllerParams::Validate() const {
     throw InvalidArgument(fmt::format("cell controller {}", e.what()));
   }
   RequirePositiveCount(max_plans_per_scan, "max_plans_per_scan");
+  if (!std::isfinite(failed_grasp_radius) || failed_grasp_radius < 0.0)
+    throw InvalidArgument(
+        fmt::format("cell controller failed_grasp_radius: must be a finite distance >= 0 m (0 = off), got {}",
+                    failed_grasp_radius));
   RequirePositiveDuration(plan_deadline, "plan_deadline");
   RequirePositiveDuration(analyze_deadline, "analyze_deadline");
   RequirePositiveCount(max_attempts_per_tube, "max_attempts_per_tube");

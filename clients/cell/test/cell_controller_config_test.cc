@@ -63,6 +63,7 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.seed, b.seed);
   EXPECT_EQ(a.max_plans, b.max_plans);
   EXPECT_EQ(a.max_plans_per_scan, b.max_plans_per_scan);
+  EXPECT_EQ(a.failed_grasp_radius, b.failed_grasp_radius);
   EXPECT_EQ(a.disable_simulation, b.disable_simulation);
   EXPECT_EQ(a.resolution_variant, b.resolution_variant);
   EXPECT_EQ(a.plan_deadline, b.plan_deadline);
@@ -156,6 +157,7 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.tube_mass_check.limits.max_off_whole = 0.15;
   p.ft_samples = 9;
   p.max_plans_per_scan = 3;
+  p.failed_grasp_radius = 0.025;
   p.max_attempts_per_tube = 5;
   p.max_consecutive_failures = 7;
   p.scanner_timeout = milliseconds(31'000);
@@ -225,6 +227,10 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
   EXPECT_NE(ParseError("max_attempts_per_bin: 0\n").find("max_attempts_per_bin: must be at least 1, got 0"),
             std::string::npos);
   EXPECT_NE(ParseError("robot_timeout: 0\n").find("robot_timeout: must be positive"), std::string::npos);
+  EXPECT_NE(ParseError("failed_grasp_radius: -0.01\n")
+                .find("failed_grasp_radius: must be a finite distance >= 0 m (0 = off), got -0.01"),
+            std::string::npos)
+      << ParseError("failed_grasp_radius: -0.01\n");
   // Below a millisecond rounds to 0 ms: rejected, not silently infinite or zero.
   EXPECT_NE(ParseError("ft_timeout: 0.0001\n").find("ft_timeout: must be positive"), std::string::npos);
   EXPECT_NE(

@@ -89,6 +89,19 @@ class CellControllerTest : public ::testing::Test {
   /// The controller of the Run / DryRun under way (for an observer that asks it to stop).
   CellController* running = nullptr;
   const Eigen::Vector3d p_Bin_grasp{0.1, -0.05, 0.03};
+  /// The i-th of several grasps 4 cm apart (a 5 x 2 grid from p_Bin_grasp): a failed grasp's spot is
+  /// not planned again (failed_grasp_radius), so scripted retries grasp elsewhere.
+  Eigen::Vector3d GraspSpot(int i) const {
+    return p_Bin_grasp + Eigen::Vector3d(-0.04 * (i % 5), 0.04 * (i / 5), 0.0);
+  }
+  /// Scan 1 plans grasp A, which closes on nothing; scan 2 plans A again first, then B elsewhere.
+  void ScriptGraspFailedThenSameGrasp() {
+    params.max_plans_per_scan = 1;
+    planner.plan_answers = {Plans({MakePlan(1, p_Bin_grasp)}, 2),
+                            Plans({MakePlan(1, p_Bin_grasp), MakePlan(2, GraspSpot(4))}, 2)};
+    gripper.close_results = {ClosedOnNothing()};
+    planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  }
 };
 
 TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
@@ -243,8 +256,8 @@ TEST_F(CellControllerTest, NothingGraspedOpensAndTriesTheNextPlanOfTheSameScan) 
 
 TEST_F(CellControllerTest, NothingGraspedOnTheLastPlanRescans) {
   params.max_plans_per_scan = 1;
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp), MakePlan(2, p_Bin_grasp)}, 2));
-  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp), MakePlan(2, GraspSpot(1))}, 2));
+  planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(2))}, 2));
   gripper.close_results = {ClosedOnNothing()};
   planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
 
@@ -325,10 +338,60 @@ TEST_F(CellControllerTest, NoneAfterLiftOpensAndRescans) {
   EXPECT_EQ(attempts[0]["result"], "none");
 }
 
+TEST_F(CellControllerTest, AGraspThatLiftedNothingIsNotTriedAgainUntilAPick) {
+  // Scan 1: the grasp at A lifts nothing (a branch pinned under another tube slips out of the pads).
+  // Scan 2 plans A again, 3 mm off, and B: A is skipped, B picks. Scan 3, after the pick: A is tried.
+  const Eigen::Vector3d A = p_Bin_grasp;
+  const Eigen::Vector3d B = GraspSpot(3);
+  planner.plan_answers.push_back(Plans({MakePlan(1, A)}, 3));
+  planner.plan_answers.push_back(
+      Plans({MakePlan(1, A + Eigen::Vector3d(0.003, 0.0, 0.0)), MakePlan(2, B)}, 3));
+  planner.plan_answers.push_back(Plans({MakePlan(1, A)}, 2));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.01), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0),
+                            Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 2u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 3u);
+  EXPECT_EQ(attempts[0]["result"], "none");
+  EXPECT_EQ(attempts[1]["tube"], 2);
+  ASSERT_EQ(attempts[1]["skipped_plans"].size(), 1u);
+  const json& skipped = attempts[1]["skipped_plans"][0];
+  EXPECT_EQ(skipped["check"], "failed_grasp");
+  EXPECT_EQ(skipped["tube"], 1);
+  EXPECT_THAT(skipped["reason"].get<std::string>(),
+              ::testing::HasSubstr("0.003 m from the grasp of attempt 1 (none) at (0.100, -0.050, 0.030) m"));
+  EXPECT_EQ(attempts[2]["tube"], 1);
+  EXPECT_TRUE(attempts[2]["skipped_plans"].empty());
+  EXPECT_EQ(attempts[2]["result"], "picked");
+}
+
+TEST_F(CellControllerTest, AGraspThatClosedOnNothingIsNotTriedAgain) {
+  ScriptGraspFailedThenSameGrasp();
+  EXPECT_EQ(Run().picks, 1u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_EQ(attempts[0]["result"], "grasp_failed");
+  EXPECT_EQ(attempts[1]["tube"], 2);
+  EXPECT_EQ(attempts[1]["skipped_plans"][0]["check"], "failed_grasp");
+}
+
+TEST_F(CellControllerTest, AFailedGraspRadiusOfZeroTriesTheSameGraspAgain) {
+  ScriptGraspFailedThenSameGrasp();
+  params.failed_grasp_radius = 0.0;
+  EXPECT_EQ(Run().picks, 1u);
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_EQ(attempts[0]["result"], "grasp_failed");
+  EXPECT_EQ(attempts[1]["tube"], 1);
+  EXPECT_TRUE(attempts[1]["skipped_plans"].empty());
+}
+
 TEST_F(CellControllerTest, LiftsThatWeighNoWholeNumberOfTubesDoubtTubeMass) {
   // Tubes lighter than the cell's tube.mass says: each lift weighs about 0.75 tubes, Algorithm 3's
   // "none" every time. From the third such lift on, the records and the round's line name tube.mass.
-  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 3));
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
                             Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
 
@@ -353,7 +416,7 @@ TEST_F(CellControllerTest, LiftsThatWeighNoWholeNumberOfTubesDoubtTubeMass) {
 }
 
 TEST_F(CellControllerTest, LiftsOfWholeTubesRaiseNoDoubt) {
-  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 3));
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
                             Outcome(v1::HELD_OUTCOME_NONE, 0.85)};
   const CellRunResult result = Run();
@@ -363,7 +426,7 @@ TEST_F(CellControllerTest, LiftsOfWholeTubesRaiseNoDoubt) {
 }
 
 TEST_F(CellControllerTest, TheTubeMassCheckTakesItsLimitsFromTheControllerParams) {
-  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 3));
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
                             Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
   params.tube_mass_check.limits.window = 2;
@@ -379,7 +442,7 @@ TEST_F(CellControllerTest, TheTubeMassCheckTakesItsLimitsFromTheControllerParams
 }
 
 TEST_F(CellControllerTest, ATubeMassCheckTurnedOffRecordsNoDoubt) {
-  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 3));
+  for (int i = 0; i < 3; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 3));
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.74), Outcome(v1::HELD_OUTCOME_NONE, 0.76),
                             Outcome(v1::HELD_OUTCOME_NONE, 0.75)};
   params.tube_mass_check.enabled = false;
@@ -500,7 +563,7 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
 TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
   params.max_attempts_per_tube = 3;
   params.max_plans_per_scan = 1;
-  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 2));
   for (int i = 0; i < 5; ++i) gripper.close_results.push_back(ClosedOnNothing());
 
   const CellRunResult result = Run();
@@ -542,7 +605,7 @@ TEST_F(CellControllerTest, AnAttemptLimitListsTheLastEightAttempts) {
   params.max_attempts_per_tube = 10;
   params.max_consecutive_failures = 20;
   params.max_plans_per_scan = 1;
-  for (int i = 0; i < 10; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, p_Bin_grasp)}, 2));
+  for (int i = 0; i < 10; ++i) planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 2));
   for (int i = 0; i < 10; ++i) gripper.close_results.push_back(ClosedOnNothing());
   const CellRunResult result = Run();
   EXPECT_EQ(result.attempts, 10u);
