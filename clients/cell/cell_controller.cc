@@ -383,9 +383,13 @@ void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& r
   }
 }
 
-/// A grasp that closed on nothing or lifted nothing leaves the bin as it was: remember where.
+/// A grasp that closed on nothing or lifted nothing leaves the bin as it was: remember where. Any
+/// other attempt moved tubes (picked, put back, lost): the grasps that failed before may work now.
 void CellController::RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run) {
-  if (outcome != AttemptResult::kNone && outcome != AttemptResult::kGraspFailed) return;
+  if (outcome != AttemptResult::kNone && outcome != AttemptResult::kGraspFailed) {
+    run.failed_grasps.clear();
+    return;
+  }
   const auto grasp = record.find("grasp");
   if (grasp == record.end() || !grasp->contains("tcp_pose")) return;
   const nlohmann::json& p = (*grasp)["tcp_pose"]["position"];
@@ -417,7 +421,6 @@ bool CellController::CountAttempt(AttemptResult outcome, RunState& run) {
     ++run.result.picks;
     run.attempts_since_pick = 0;
     run.since_pick.clear();
-    run.failed_grasps.clear();
     run.consecutive_failures = 0;
     run.nudges_since_pick = 0;
     return false;
@@ -459,7 +462,10 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
     spdlog::error("cell: round {} scan {}: {}", round_, scan.index, message);
   }
   record["durations"] = PlanningDurationsJson(scan.planning_wall_s, scan.response.total_seconds());
-  if (nudge) record = Nudge(*nudge, std::move(record), scan, run);
+  if (nudge) {
+    record = Nudge(*nudge, std::move(record), scan, run);
+    run.failed_grasps.clear();  // the nudge moved a tube
+  }
   record["durations"]["attempt_wall_s"] = SecondsSince(scan.started);
   record["durations"]["attempt_device_s"] = DeviceNow() - scan.device_started;
   record["truth_after"] = Truth();

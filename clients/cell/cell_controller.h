@@ -229,7 +229,7 @@ nlohmann::json DryRunJson(const DryRunResult& dry);
 /// or in millimetres), that the arm cannot reach (Robot::Limits: pre-grasp, grasp, lift waypoints,
 /// placement) or the tool cannot execute without touching the bin (ToolClearanceProblem) are
 /// skipped before any motion, and so are plans that grasp within failed_grasp_radius of a grasp that
-/// closed on or lifted nothing since the last pick (the bin is as it was: the same grasp fails the
+/// closed on or lifted nothing since tubes last moved (the bin is as it was: the same grasp fails the
 /// same way); all are listed in the next record's skipped_plans ({rank, tube, check: "failed_grasp" |
 /// "cell_frame" | "robot_limits" | "tool_clearance", reason}); when every plan of a scan was skipped
 /// as not fitting the cell, its "no_plan" record says so (cell_mismatch) and no nudge is tried; a scan
@@ -340,7 +340,8 @@ class CellController {
   static void CountAttemptWrench(const Attempt& attempt, CellRunResult& result);
   /// Counts the attempt's outcome; true when the next plan of the same scan may be tried.
   bool CountAttempt(AttemptResult outcome, RunState& run);
-  /// Keeps the grasp of an attempt that closed on or lifted nothing (params.failed_grasp_radius).
+  /// Keeps the grasp of an attempt that closed on or lifted nothing (params.failed_grasp_radius);
+  /// forgets them all after an attempt that moved tubes.
   void RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run);
   /// "failed_grasp" when the plan's grasp point is within failed_grasp_radius of such a grasp.
   std::optional<PlanSkip> RepeatsFailedGrasp(const v1::PickPlan& plan, const RunState& run) const;

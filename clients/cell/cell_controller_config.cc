@@ -131,7 +131,7 @@ void DescribePlannerFields(Visit& v, CellControllerParams& p) {
   v("max_plans", p.max_plans, "per scan, 0 = all");
   v("max_plans_per_scan", p.max_plans_per_scan, "executed before a rescan");
   v("failed_grasp_radius", p.failed_grasp_radius,
-    "m: plans this close to a grasp that closed on or lifted nothing since the last pick are skipped; 0 = "
+    "m: plans this close to a grasp that closed on or lifted nothing since tubes last moved are skipped; 0 = "
     "off");
   v("disable_simulation", p.disable_simulation);
   v.Enum("resolution_variant", p.resolution_variant, VariantToName, VariantFromName,

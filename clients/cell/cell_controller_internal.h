@@ -117,7 +117,8 @@ struct CellController::RunState {
   /// lift's outcome and tubes of tube.mass; "grasp_failed"; "no plan, nudged tube 3"), for the message
   /// of a limit.
   std::vector<std::string> since_pick;
-  /// Grasps since the last pick that closed on nothing or lifted nothing (failed_grasp_radius).
+  /// Grasps that closed on nothing or lifted nothing since tubes last moved (a pick, a put-back, a
+  /// lost tube, a nudge): failed_grasp_radius.
   struct FailedGrasp {
     Eigen::Vector3d p_Bin_grasp = Eigen::Vector3d::Zero();
     std::uint32_t attempt = 0;

@@ -125,9 +125,9 @@ struct CellControllerParams {
   /// Plans executed on one scan when grasps close on nothing (then rescan).
   std::uint32_t max_plans_per_scan = 2;
   /// A plan whose grasp point lies within this distance of a grasp that closed on nothing or lifted
-  /// nothing since the last pick is skipped (check "failed_grasp"), metres: the bin is unchanged by
-  /// such an attempt, and the same grasp fails the same way (4 lifts of a rubber branch pinned under
-  /// a tree, 3 mm apart, in one simulated round). 0 = retry them.
+  /// nothing since tubes last moved (a pick, a put-back, a lost tube, a nudge) is skipped (check
+  /// "failed_grasp"), metres: the bin is unchanged by such an attempt, and the same grasp fails the same way
+  /// (4 lifts of a rubber branch pinned under a tree, 3 mm apart, in one simulated round). 0 = retry them.
   double failed_grasp_radius = 0.03;
   bool disable_simulation = false;
   /// Resolution rotation requested from AnalyzeWrench (UNSPECIFIED = the server's).

@@ -367,6 +367,22 @@ TEST_F(CellControllerTest, AGraspThatLiftedNothingIsNotTriedAgainUntilAPick) {
   EXPECT_EQ(attempts[2]["result"], "picked");
 }
 
+TEST_F(CellControllerTest, AFailedGraspIsTriedAgainOnceTubesWerePutBack) {
+  // Attempt 1 at A lifts nothing; attempt 2 at B lifts two tubes, which are put back: the bin changed,
+  // so scan 3's grasp at A is executed again.
+  planner.plan_answers = {Plans({MakePlan(1, p_Bin_grasp)}, 3), Plans({MakePlan(2, GraspSpot(3))}, 3),
+                          Plans({MakePlan(1, p_Bin_grasp)}, 3)};
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_NONE, 0.01), Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0),
+                            Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  Run();
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 3u);
+  EXPECT_EQ(attempts[0]["result"], "none");
+  EXPECT_EQ(attempts[1]["result"], "multiple_returned");
+  EXPECT_EQ(attempts[2]["tube"], 1);
+  EXPECT_TRUE(attempts[2]["skipped_plans"].empty());
+}
+
 TEST_F(CellControllerTest, AGraspThatClosedOnNothingIsNotTriedAgain) {
   ScriptGraspFailedThenSameGrasp();
   EXPECT_EQ(Run().picks, 1u);
