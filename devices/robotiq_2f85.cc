@@ -128,26 +128,55 @@ Robotiq2F85::~Robotiq2F85() {
   }
 }
 
-robotiq::InputState Robotiq2F85::ReadInput() {
-  std::array<std::uint16_t, robotiq::kRegisterCount> regs{};
-  modbus_flush(ctx_);  // drop a late answer to an earlier, timed-out request
-  if (modbus_read_input_registers(ctx_, robotiq::kInputAddress, robotiq::kRegisterCount, regs.data()) !=
-      robotiq::kRegisterCount) {
-    const int err = errno;
-    if (err == ETIMEDOUT) throw DeviceTimeout("Robotiq2F85: no answer to status read on " + params_.device);
-    throw DeviceFault(std::string("Robotiq2F85: status read failed: ") + modbus_strerror(err));
+namespace {
+
+// An unanswered request (or one answered with a bad CRC: a noisy RS-485 line) is sent again while the
+// call's deadline leaves time for a whole response_timeout; both requests are idempotent (a status
+// read, the action request registers written again). Returns the tries made; throws when out of time.
+template <typename Request>
+int WithRetries(Request&& request, std::chrono::steady_clock::time_point deadline,
+                std::chrono::milliseconds response_timeout, const std::string& what,
+                const std::string& device) {
+  for (int tries = 1;; ++tries) {
+    const int err = request();
+    if (err == 0) return tries;
+    const bool retriable = err == ETIMEDOUT || err == EMBBADCRC;
+    if (retriable && std::chrono::steady_clock::now() + response_timeout <= deadline) continue;
+    const std::string count = std::to_string(tries) + (tries == 1 ? " try" : " tries");
+    if (err == ETIMEDOUT)
+      throw DeviceTimeout("Robotiq2F85: no answer to " + what + " on " + device + " (" + count + ")");
+    throw DeviceFault("Robotiq2F85: " + what + " failed on " + device + " (" + count +
+                      "): " + modbus_strerror(err));
   }
+}
+
+}  // namespace
+
+robotiq::InputState Robotiq2F85::ReadInput(std::chrono::steady_clock::time_point deadline) {
+  std::array<std::uint16_t, robotiq::kRegisterCount> regs{};
+  WithRetries(
+      [&] {
+        modbus_flush(ctx_);  // drop a late answer to an earlier, timed-out request
+        return modbus_read_input_registers(ctx_, robotiq::kInputAddress, robotiq::kRegisterCount,
+                                           regs.data()) == robotiq::kRegisterCount
+                   ? 0
+                   : errno;
+      },
+      deadline, params_.response_timeout, "status read", params_.device);
   return robotiq::DecodeInput(regs);
 }
 
-void Robotiq2F85::WriteOutput(const std::array<std::uint16_t, robotiq::kRegisterCount>& regs) {
-  modbus_flush(ctx_);
-  if (modbus_write_registers(ctx_, robotiq::kOutputAddress, robotiq::kRegisterCount, regs.data()) !=
-      robotiq::kRegisterCount) {
-    const int err = errno;
-    if (err == ETIMEDOUT) throw DeviceTimeout("Robotiq2F85: no answer to request write on " + params_.device);
-    throw DeviceFault(std::string("Robotiq2F85: request write failed: ") + modbus_strerror(err));
-  }
+void Robotiq2F85::WriteOutput(const std::array<std::uint16_t, robotiq::kRegisterCount>& regs,
+                              std::chrono::steady_clock::time_point deadline) {
+  WithRetries(
+      [&] {
+        modbus_flush(ctx_);
+        return modbus_write_registers(ctx_, robotiq::kOutputAddress, robotiq::kRegisterCount, regs.data()) ==
+                       robotiq::kRegisterCount
+                   ? 0
+                   : errno;
+      },
+      deadline, params_.response_timeout, "request write", params_.device);
 }
 
 GripperStatus Robotiq2F85::ToStatus(const robotiq::InputState& s) {
@@ -182,10 +211,10 @@ void Robotiq2F85::ThrowIfFault(const robotiq::InputState& s) {
 void Robotiq2F85::Activate(Timeout timeout) {
   std::lock_guard lock(mutex_);
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  WriteOutput(robotiq::EncodeRequest(0, 0, 0, 0));  // clear rACT: resets faults
-  WriteOutput(robotiq::EncodeRequest(robotiq::kRact, 0, 0, 0));
+  WriteOutput(robotiq::EncodeRequest(0, 0, 0, 0), deadline);  // clear rACT: resets faults
+  WriteOutput(robotiq::EncodeRequest(robotiq::kRact, 0, 0, 0), deadline);
   for (;;) {
-    const auto s = ReadInput();
+    const auto s = ReadInput(deadline);
     ThrowIfFault(s);
     if (s.gsta == 3) return;
     if (std::chrono::steady_clock::now() >= deadline) {
@@ -201,9 +230,10 @@ GripperStatus Robotiq2F85::MoveTo(double opening, double speed, double force, Ti
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   const std::uint8_t pos = robotiq::OpeningToPosition(opening);
   WriteOutput(robotiq::EncodeRequest(robotiq::kRact | robotiq::kRgto, pos, robotiq::SpeedToByte(speed),
-                                     robotiq::ForceToByte(force)));
+                                     robotiq::ForceToByte(force)),
+              deadline);
   for (;;) {
-    const auto s = ReadInput();
+    const auto s = ReadInput(deadline);
     ThrowIfFault(s);
     // The echo tells us the status belongs to this request, not the previous one.
     if (s.position_echo == pos && s.ggto && s.gobj != 0) return ToStatus(s);
@@ -223,10 +253,10 @@ GripperStatus Robotiq2F85::Close(double speed, double force, Timeout timeout) {
   return MoveTo(0.0, speed, force, timeout);
 }
 
-GripperStatus Robotiq2F85::Status(Timeout /*timeout: one request, bounded by response_timeout*/) {
+GripperStatus Robotiq2F85::Status(Timeout timeout) {
   std::lock_guard lock(mutex_);
   // A fault is reported in the status (fault, fault_text), not thrown: this is how callers inspect it.
-  return ToStatus(ReadInput());
+  return ToStatus(ReadInput(std::chrono::steady_clock::now() + timeout));
 }
 
 }  // namespace tubepick::devices

@@ -75,7 +75,8 @@ struct Robotiq2F85Params {
   std::string device = "/dev/ttyUSB0";
   int slave_id = robotiq::kDefaultSlaveId;
   int baud = robotiq::kDefaultBaud;  ///< 8N1
-  /// Per Modbus request; an unanswered request throws DeviceTimeout.
+  /// Per Modbus request; an unanswered request is sent again while the call's timeout leaves this
+  /// much, then DeviceTimeout.
   std::chrono::milliseconds response_timeout{200};
   std::chrono::milliseconds poll_period{10};
 };
@@ -99,8 +100,10 @@ class Robotiq2F85 final : public Gripper {
   GripperStatus Status(Timeout timeout) override;
 
  private:
-  robotiq::InputState ReadInput();
-  void WriteOutput(const std::array<std::uint16_t, robotiq::kRegisterCount>& regs);
+  /// One Modbus request each, sent again while unanswered and `deadline` leaves a response_timeout.
+  robotiq::InputState ReadInput(std::chrono::steady_clock::time_point deadline);
+  void WriteOutput(const std::array<std::uint16_t, robotiq::kRegisterCount>& regs,
+                   std::chrono::steady_clock::time_point deadline);
   static GripperStatus ToStatus(const robotiq::InputState& s);
   static void ThrowIfFault(const robotiq::InputState& s);
 

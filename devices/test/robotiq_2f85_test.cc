@@ -145,6 +145,30 @@ TEST(Robotiq2F85, NoAnswerThrowsDeviceTimeout) {
   EXPECT_TRUE(gripper.Status(1s).activated);
 }
 
+TEST(Robotiq2F85, ALostRequestIsSentAgainWithinTheCallsTimeout) {
+  // A noisy RS-485 line loses frames: the fake drops the next two requests (a write and a read, each
+  // unanswered for response_timeout 100 ms); the call sends them again and completes.
+  RobotiqFake fake;
+  fake.SetObjectWidth(0.016);
+  Robotiq2F85 gripper(ParamsFor(fake));
+  gripper.Activate(2s);
+  fake.DropNext(2);
+  const auto closed = gripper.Close(0.15, 50.0, 5s);
+  EXPECT_EQ(closed.object, GripperObject::kStoppedClosing);
+  fake.DropNext(1);
+  EXPECT_TRUE(gripper.Status(1s).activated);
+  // Silent for longer than the call allows: a DeviceTimeout saying how often it asked.
+  fake.SetMute(true);
+  try {
+    gripper.Status(350ms);
+    FAIL() << "expected DeviceTimeout";
+  } catch (const DeviceTimeout& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no answer to status read on"), std::string::npos) << what;
+    EXPECT_NE(what.find("(3 tries)"), std::string::npos) << what;
+  }
+}
+
 TEST(Robotiq2F85, ActivationThatNeverCompletesTimesOut) {
   RobotiqFake::Options o;
   o.activation_time = 10s;

@@ -80,6 +80,11 @@ void RobotiqFake::SetMute(bool mute) {
   mute_ = mute;
 }
 
+void RobotiqFake::DropNext(int count) {
+  std::lock_guard lock(mutex_);
+  drop_ = count;
+}
+
 double RobotiqFake::position() const {
   std::lock_guard lock(mutex_);
   return pos_;
@@ -96,6 +101,10 @@ void RobotiqFake::Run() {
     last = now;
     if (rc <= 0) continue;  // timeout, bad frame, or another slave's request
     if (mute_) continue;
+    if (drop_ > 0) {
+      --drop_;
+      continue;
+    }
     const int function = req[1];
     if (modbus_reply(ctx_, req, rc, map_) > 0) served_++;
     if (function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS || function == MODBUS_FC_WRITE_SINGLE_REGISTER) {

@@ -40,6 +40,8 @@ class RobotiqFake {
   void SetFault(std::uint8_t code);
   /// Stop answering requests (requests are read and dropped).
   void SetMute(bool mute);
+  /// Read and drop the next `count` requests (a noisy line losing frames), then answer again.
+  void DropNext(int count);
   /// Current simulated finger position (0 open .. 255 closed).
   double position() const;
   int requests_served() const { return served_.load(); }
@@ -60,6 +62,7 @@ class RobotiqFake {
   std::optional<double> object_width_;
   std::uint8_t fault_ = 0;
   bool mute_ = false;
+  int drop_ = 0;
   bool activated_ = false;
   bool activating_ = false;
   std::chrono::steady_clock::time_point activation_start_;
