@@ -132,14 +132,14 @@ namespace {
 
 // An unanswered request (or one answered with a bad CRC: a noisy RS-485 line) is sent again while the
 // call's deadline leaves time for a whole response_timeout; both requests are idempotent (a status
-// read, the action request registers written again). Returns the tries made; throws when out of time.
+// read, the action request registers written again). Throws when out of time.
 template <typename Request>
-int WithRetries(Request&& request, std::chrono::steady_clock::time_point deadline,
-                std::chrono::milliseconds response_timeout, const std::string& what,
-                const std::string& device) {
+void WithRetries(Request&& request, std::chrono::steady_clock::time_point deadline,
+                 std::chrono::milliseconds response_timeout, const std::string& what,
+                 const std::string& device) {
   for (int tries = 1;; ++tries) {
     const int err = request();
-    if (err == 0) return tries;
+    if (err == 0) return;
     const bool retriable = err == ETIMEDOUT || err == EMBBADCRC;
     if (retriable && std::chrono::steady_clock::now() + response_timeout <= deadline) continue;
     const std::string count = std::to_string(tries) + (tries == 1 ? " try" : " tries");

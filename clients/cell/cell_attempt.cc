@@ -113,6 +113,7 @@ void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& at
   const PlanPoses poses = PosesOf(plan, rank);
   const double opening_width = plan.grasp().opening_width();
   attempt.record["grasp"] = GraspJson(poses.X_BinTcpGrasp, poses.approach_Bin, opening_width);
+  attempt.p_Bin_grasp = poses.X_BinTcpGrasp.translation();
 
   Approach(poses.X_BinTcpPreGrasp, opening_width, attempt);
   const devices::WrenchReading reference = TakeReference(attempt);

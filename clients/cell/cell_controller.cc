@@ -366,7 +366,7 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   record["truth_after"] = Truth();
   CountAttemptWrench(attempt, run.result);
   run.since_pick.push_back(DescribeAttemptBriefly(record));
-  RememberFailedGrasp(outcome, record, run);
+  RememberFailedGrasp(outcome, attempt, run);
   if (sink_) sink_->Write(record);
   spdlog::info("cell: round {} attempt {}: tube {} {} -> {}", round_, run.result.attempts,
                record.value("tube", 0u), record.value("trajectory_kind", ""),
@@ -385,16 +385,14 @@ void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& r
 
 /// A grasp that closed on nothing or lifted nothing leaves the bin as it was: remember where. Any
 /// other attempt moved tubes (picked, put back, lost): the grasps that failed before may work now.
-void CellController::RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run) {
+void CellController::RememberFailedGrasp(AttemptResult outcome, const Attempt& attempt, RunState& run) {
   if (outcome != AttemptResult::kNone && outcome != AttemptResult::kGraspFailed) {
     run.failed_grasps.clear();
     return;
   }
-  const auto grasp = record.find("grasp");
-  if (grasp == record.end() || !grasp->contains("tcp_pose")) return;
-  const nlohmann::json& p = (*grasp)["tcp_pose"]["position"];
-  run.failed_grasps.push_back({Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>()),
-                               record.value("attempt", 0u), record.value("result", std::string())});
+  if (!attempt.p_Bin_grasp) return;
+  run.failed_grasps.push_back(
+      {*attempt.p_Bin_grasp, run.result.attempts, ResultName(static_cast<int>(outcome))});
 }
 
 /// The plan grasps within failed_grasp_radius of a grasp that failed since the last pick.

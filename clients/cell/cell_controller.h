@@ -342,7 +342,7 @@ class CellController {
   bool CountAttempt(AttemptResult outcome, RunState& run);
   /// Keeps the grasp of an attempt that closed on or lifted nothing (params.failed_grasp_radius);
   /// forgets them all after an attempt that moved tubes.
-  void RememberFailedGrasp(AttemptResult outcome, const nlohmann::json& record, RunState& run);
+  void RememberFailedGrasp(AttemptResult outcome, const Attempt& attempt, RunState& run);
   /// "failed_grasp" when the plan's grasp point is within failed_grasp_radius of such a grasp.
   std::optional<PlanSkip> RepeatsFailedGrasp(const v1::PickPlan& plan, const RunState& run) const;
   /// A scan without an executable plan: a "no_plan" record, or a nudge and its record.

@@ -81,6 +81,8 @@ struct CellController::Attempt {
   detail::Clock::time_point started = detail::Clock::now();
   double device_started = 0.0;
   std::optional<AttemptResult> result;
+  /// The grasp point once the plan's poses are known (failed_grasp_radius remembers it).
+  std::optional<Eigen::Vector3d> p_Bin_grasp;
 };
 
 /// The held tube is gone (a slip, a drop): where it was noticed and by what.

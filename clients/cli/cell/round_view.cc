@@ -36,9 +36,11 @@ int Count(const nlohmann::json& r, const char* key, int fallback) {
   return it != r.end() && it->is_number() ? it->get<int>() : fallback;
 }
 
+// A picking attempt's record; a scan without a plan (perhaps a nudge) has "attempt": null.
+bool IsPickingAttempt(const nlohmann::json& r) { return r.contains("attempt") && r["attempt"].is_number(); }
+
 std::string AttemptNote(const nlohmann::json& r) {
-  if (!r.contains("attempt") || !r["attempt"].is_number())  // a scan without a plan, perhaps a nudge
-    return cell::DescribeAttemptBriefly(r);
+  if (!IsPickingAttempt(r)) return cell::DescribeAttemptBriefly(r);
   std::string note = fmt::format(
       "attempt {}: plan #{} (tube {}, {}) → {}", Count(r, "attempt", 0), Count(r, "plan_rank", 0) + 1,
       Count(r, "tube", 0), r.value("trajectory_kind", std::string("-")), r.value("result", std::string("-")));
@@ -115,8 +117,7 @@ void RoundViewRecorder::Annotate(const nlohmann::json& record) {
   const std::string type = record.value("type", std::string());
   if (type == "attempt") {
     // A scan without a plan records plan_rank 0 with "attempt": null: no plan was chosen.
-    if (record.contains("attempt") && record["attempt"].is_number() && record.contains("plan_rank") &&
-        record["plan_rank"].is_number())
+    if (IsPickingAttempt(record) && record.contains("plan_rank") && record["plan_rank"].is_number())
       last.chosen_plan = record["plan_rank"].get<int>();
     last.note = AttemptNote(record);
   } else if (type == "safe_stop") {
