@@ -44,6 +44,27 @@ TEST(CellCliTest, OneRoundWithAnAutoStartedServerPrintsTheTables) {
   EXPECT_NE(records.find("\"type\":\"end\""), std::string::npos);
 }
 
+// A full disk under --records (/dev/full: every write fails with ENOSPC) does not stop the cell:
+// the bin is emptied, the run says how many records were lost and why, and exits 6.
+TEST(CellCliTest, RecordsThatCannotBeWrittenDoNotStopTheCellButExit6) {
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 1 --seed 3 --records /dev/full");
+  EXPECT_EQ(run.exit_code, 6) << run.output;
+  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tubes picked"), std::string::npos) << run.output;
+  EXPECT_TRUE(
+      std::regex_search(run.output, std::regex("records: /dev/full: ([2-9]|\\d\\d+) of \\1 records could "
+                                               "not be written \\(No space left on device\\)")))
+      << run.output;
+  EXPECT_EQ(run.output.find("SAFE STOP"), std::string::npos) << run.output;
+}
+
+// --json on a full disk is an error, not "wrote /dev/full".
+TEST(CellCliTest, AJsonReportThatCannotBeWrittenIsAnError) {
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 1 --seed 3 --json /dev/full");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("--json /dev/full: error writing (disk full?)"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("wrote /dev/full"), std::string::npos) << run.output;
+}
+
 TEST(CellCliTest, UnreachableServerEndsInASafeStopAndExitStatus3) {
   const testing::CliRun run = RunCli("cell --sim --rounds 2 --tubes 1 --server 127.0.0.1:1");
   EXPECT_EQ(run.exit_code, 3) << run.output;

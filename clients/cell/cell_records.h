@@ -1,6 +1,6 @@
 #pragma once
 
-#include <fstream>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,17 +21,48 @@ class RecordSink {
   virtual void Write(const nlohmann::json& record) = 0;
 };
 
-/// JSON lines: one compact object per line, flushed after each record (a crash loses nothing).
+/// JSON lines: one compact object per line, handed to the kernel as one write per record (a crash of
+/// this process loses nothing written).
+///
+/// Writing never throws: the records are the cell's trace, and a full disk must not interrupt a
+/// pick under way (an exception in the controller's record sink ends in a safe stop). A record that
+/// cannot be written (disk full, quota, I/O error) is counted in lost(), the file is cut back to
+/// its last whole line, and an error naming the file, the reason and the record's type is logged
+/// for the first record of each run of failures; the next record tries again, and the first that
+/// gets through logs how many were lost before it. The caller reports lost() when the run ends.
 class JsonLinesFileSink final : public RecordSink {
  public:
   /// @param append keep what the file holds. @throws InvalidArgument when it cannot be opened.
   explicit JsonLinesFileSink(const std::string& path, bool append = false);
+  ~JsonLinesFileSink() override;
+  JsonLinesFileSink(const JsonLinesFileSink&) = delete;
+  JsonLinesFileSink& operator=(const JsonLinesFileSink&) = delete;
+
   void Write(const nlohmann::json& record) override;
+
+  const std::string& path() const { return path_; }
+  /// Records written whole.
+  std::uint64_t written() const { return written_; }
+  /// Records that could not be written.
+  std::uint64_t lost() const { return lost_; }
+  /// Why the last lost record was lost ("No space left on device"); empty when none was.
+  const std::string& last_error() const { return last_error_; }
 
  private:
   std::string path_;
-  std::ofstream out_;
+  int fd_ = -1;
+  // File size after the last whole record: a partial write is cut back to it.
+  std::int64_t good_size_ = 0;
+  std::uint64_t written_ = 0;
+  std::uint64_t lost_ = 0;
+  // Records lost since the last one written (the current run of failures).
+  std::uint64_t failing_ = 0;
+  std::string last_error_;
 };
+
+/// One line on a records file for the end of a run: "records: PATH" when every record was
+/// written, else how many were lost and why.
+std::string DescribeRecordsFile(const JsonLinesFileSink& sink);
 
 /// Keeps the records in memory (statistics, tests).
 class MemoryRecordSink final : public RecordSink {

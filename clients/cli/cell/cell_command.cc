@@ -37,6 +37,11 @@ namespace {
 
 using nlohmann::json;
 
+/// Exit status of a run whose --records file lost records (a full disk): the cell did its work,
+/// its trace is incomplete (4 is a cloud that does not fit the cell, 5 a failed devices check). A safe
+/// stop (3) or a signal (128 + it) takes precedence.
+constexpr int kExitRecordsLost = 6;
+
 struct CellOptions {
   bool sim = false;
   std::uint32_t rounds = 1;
@@ -115,6 +120,12 @@ struct RecordSinks {
   cell::PlannerClient& planner(cell::PlannerClient& direct) {
     return view ? static_cast<cell::PlannerClient&>(*view) : direct;
   }
+  /// The records file's line (after the run); true when records were lost.
+  bool PrintRecordsFile() const {
+    if (!file) return false;
+    fmt::print("{}\n", cell::DescribeRecordsFile(*file));
+    return file->lost() > 0;
+  }
   /// Where the pages went (after the run).
   void PrintPages() const {
     if (view && !view->pages().empty())
@@ -154,6 +165,7 @@ void WriteJson(const std::string& path, const json& document) {
   std::ofstream out(path);
   if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", path));
   out << document.dump(2) << '\n';
+  if (!out.flush()) throw InvalidArgument(fmt::format("--json {}: error writing (disk full?)", path));
   fmt::print("wrote {}\n", path);
 }
 
@@ -239,7 +251,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   const cell::CellStatistics stats = cell::SummarizeRecords(records.memory.records());
   fmt::print("\n{}", FormatCellTables(stats, fmt::format("{}, {} round{}", o.devices_path, stats.rounds,
                                                          stats.rounds == 1 ? "" : "s")));
-  if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  const bool records_lost = records.PrintRecordsFile();
   records.PrintPages();
   WriteJson(o.json_path, json{{"devices", o.devices_path},
                               {"seed", o.seed},
@@ -248,6 +260,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   StopPlanner(server.get());
   if (stop.signal() != 0) ExitForSignal(stop);
   if (any_fault) throw CLI::RuntimeError(3);
+  if (records_lost) throw CLI::RuntimeError(kExitRecordsLost);
 }
 
 void Run(const CellOptions& o) {
@@ -356,7 +369,7 @@ void Run(const CellOptions& o) {
   fmt::print("\n{}", FormatCellTables(
                          stats, fmt::format("{}, {} round{} of {} tubes, seed {}", o.material, stats.rounds,
                                             stats.rounds == 1 ? "" : "s", o.tubes, o.seed)));
-  if (!o.records_path.empty()) fmt::print("records: {}\n", o.records_path);
+  const bool records_lost = records.PrintRecordsFile();
   records.PrintPages();
   if (injecting) fmt::print("{}\n{}\n", campaign.KindsLine(), campaign.SummaryLine());
   WriteJson(o.json_path, json{{"material", o.material},
@@ -371,6 +384,7 @@ void Run(const CellOptions& o) {
   if (stop.signal() != 0) ExitForSignal(stop);
   // A campaign expects safe stops; what it must never see is a tube released outside.
   if (injecting ? campaign.released_outside > 0 : any_fault) throw CLI::RuntimeError(3);
+  if (records_lost) throw CLI::RuntimeError(kExitRecordsLost);
 }
 
 }  // namespace
@@ -428,7 +442,9 @@ void AddCellCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", o->seed, "Seed of the first round's cell and the planner seeds")
       ->capture_default_str();
-  cmd->add_option("--records", o->records_path, "Write every attempt as a JSON line to this file");
+  cmd->add_option("--records", o->records_path,
+                  "Write every attempt as a JSON line to this file; a record that cannot be written (disk "
+                  "full) does not stop the cell: it is logged, counted at the end, and the exit status is 6");
   cmd->add_option("--view", o->view_dir,
                   "Write a 3-D page per round into this directory (round_NNN.html: each scan, its plans, the "
                   "pick made and what came of it)");

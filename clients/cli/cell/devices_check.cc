@@ -235,6 +235,8 @@ int Check(const CheckOptions& o) {
     std::ofstream out(o.json_path);
     if (!out) throw InvalidArgument(fmt::format("--json {}: cannot open for writing", o.json_path));
     out << json{{"devices", o.devices_path}, {"pass", all}, {"rows", rows_json}}.dump(2) << '\n';
+    if (!out.flush())
+      throw InvalidArgument(fmt::format("--json {}: error writing (disk full?)", o.json_path));
   }
   return all ? 0 : 5;
 }

@@ -54,6 +54,7 @@ void WriteFileAtomically(const fs::path& path, const std::string& text) {
     std::ofstream out(part);
     if (!out) throw InvalidArgument(fmt::format("cannot write {}", part.string()));
     out << text;
+    if (!out.flush()) throw InvalidArgument(fmt::format("error writing {} (disk full?)", part.string()));
   }
   fs::rename(part, path);
 }

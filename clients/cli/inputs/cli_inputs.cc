@@ -70,7 +70,8 @@ void WriteTextFile(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   if (!out) throw InvalidArgument("cannot write '" + path + "'");
   out << text;
-  if (!out) throw InvalidArgument("error writing '" + path + "'");
+  // Flushed here, not in the destructor, so that a full disk is an error and not a silent loss.
+  if (!out.flush()) throw InvalidArgument("error writing '" + path + "' (disk full?)");
 }
 
 }  // namespace tubepick::cli
