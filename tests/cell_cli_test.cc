@@ -49,7 +49,7 @@ TEST(CellCliTest, OneRoundWithAnAutoStartedServerPrintsTheTables) {
 TEST(CellCliTest, RecordsThatCannotBeWrittenDoNotStopTheCellButExit6) {
   const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 1 --seed 3 --records /dev/full");
   EXPECT_EQ(run.exit_code, 6) << run.output;
-  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tubes picked"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tube picked"), std::string::npos) << run.output;
   EXPECT_TRUE(
       std::regex_search(run.output, std::regex("records: /dev/full: ([2-9]|\\d\\d+) of \\1 records could "
                                                "not be written \\(No space left on device\\)")))
@@ -239,7 +239,7 @@ TEST(CellCliTest, OneRoundWithACellFileAndAControllerFile) {
   const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 1 --seed 3 --cell " + cell_path.string() +
                                      " --controller " + controller_path.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tubes picked"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("round  0 (seed 3): bin empty: 1 tube picked"), std::string::npos) << run.output;
 }
 
 }  // namespace

@@ -18,6 +18,11 @@
 namespace tubepick::cell {
 namespace {
 
+// "1 tube", "2 tubes".
+std::string Count(std::uint32_t n, const char* noun) {
+  return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s");
+}
+
 const char* ResultName(int result) {
   static const char* const kNames[] = {"picked", "multiple_returned", "none", "grasp_failed", "lost"};
   return kNames[result];
@@ -247,14 +252,14 @@ bool CellController::ScanAndPick(RunState& run) {
   CellRunResult& result = run.result;
   if (const auto why = LimitReached(run)) {
     result.reason = CellStopReason::kLimitReached;
-    result.message = fmt::format("attempt limit reached: {}; {} tubes picked", *why, result.picks);
+    result.message = fmt::format("attempt limit reached: {}; {} picked", *why, Count(result.picks, "tube"));
     return false;
   }
   PlannedScan scan = ScanBin(run);
   if (scan.response.bin_empty()) {
     result.reason = CellStopReason::kBinEmpty;
-    result.message = fmt::format("bin empty: {} tubes picked in {} attempts ({} scans)", result.picks,
-                                 result.attempts, result.scans);
+    result.message = fmt::format("bin empty: {} picked in {} ({})", Count(result.picks, "tube"),
+                                 Count(result.attempts, "attempt"), Count(result.scans, "scan"));
     return false;
   }
   if (TryPlans(scan, run) == 0) NoExecutablePlan(scan, run);
