@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 
 #include "tests/cli_test_support.h"
 
@@ -63,6 +65,47 @@ TEST(CellCliTest, AJsonReportThatCannotBeWrittenIsAnError) {
   EXPECT_NE(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("--json /dev/full: error writing (disk full?)"), std::string::npos) << run.output;
   EXPECT_EQ(run.output.find("wrote /dev/full"), std::string::npos) << run.output;
+}
+
+// The records of a run, each without its durations (wall and device times).
+std::vector<nlohmann::json> RecordsWithoutTimes(const std::filesystem::path& path) {
+  std::vector<nlohmann::json> records;
+  std::istringstream lines(testing::ReadText(path));
+  for (std::string line; std::getline(lines, line);) {
+    nlohmann::json record = nlohmann::json::parse(line);
+    record.erase("durations");
+    records.push_back(std::move(record));
+  }
+  return records;
+}
+
+// Same seed, same round: the simulated cell (rubber hoses, their lifts simulated by the planner
+// too), the planner and the controller draw only seeded randomness, so a round run alone twice,
+// or after another round, writes the same records field by field, times aside.
+TEST(CellCliTest, ARoundIsTheSameWhetherRunAgainOrAfterAnotherRound) {
+  const auto dir = testing::TempDir("cell-repeat");
+  const std::string round = "cell --sim --tubes 2 --material rubber --shapes C --records ";
+  const testing::CliRun first = RunCli(round + (dir / "a.jsonl").string() + " --seed 4 --rounds 1");
+  const testing::CliRun again = RunCli(round + (dir / "b.jsonl").string() + " --seed 4 --rounds 1");
+  const testing::CliRun after = RunCli(round + (dir / "c.jsonl").string() + " --seed 3 --rounds 2");
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  ASSERT_EQ(after.exit_code, 0) << after.output;
+  const std::vector<nlohmann::json> a = RecordsWithoutTimes(dir / "a.jsonl");
+  const std::vector<nlohmann::json> b = RecordsWithoutTimes(dir / "b.jsonl");
+  std::vector<nlohmann::json> c;
+  for (nlohmann::json record : RecordsWithoutTimes(dir / "c.jsonl")) {
+    if (record["round"] != 1) continue;
+    record["round"] = 0;
+    c.push_back(std::move(record));
+  }
+  ASSERT_GE(a.size(), 3u);  // two picks at least, and the end
+  const auto simulated = std::count_if(
+      a.begin(), a.end(), [](const nlohmann::json& r) { return r.value("used_simulation", false); });
+  EXPECT_GE(simulated, 1) << "no lift of this round was simulated: pick a round that simulates";
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(CellCliTest, UnreachableServerEndsInASafeStopAndExitStatus3) {

@@ -154,7 +154,11 @@ std::unique_ptr<RestartableServer> StartPlanner(const CellOptions& o, std::strin
   return server;
 }
 
-void StopPlanner(RestartableServer* server) {
+/// Closes the run's channel, then stops the planner this command started (if any). Closed first:
+/// a server with a client still connected takes about 1.8 s longer to shut down (gRPC waits for
+/// the connection), and the rounds are over.
+void StopPlanner(RestartableServer* server, std::unique_ptr<cell::GrpcPlannerClient>& client) {
+  client.reset();
   if (!server) return;
   const int status = server->Stop(std::chrono::seconds(15));
   spdlog::info("tubepick-server exited with status {}", status);
@@ -204,7 +208,8 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
   OperatorStop stop;
   std::string address;
   std::unique_ptr<RestartableServer> server = StartPlanner(o, address);
-  cell::GrpcPlannerClient grpc_planner(address, o.planner_options);
+  auto grpc_planner_owner = std::make_unique<cell::GrpcPlannerClient>(address, o.planner_options);
+  cell::GrpcPlannerClient& grpc_planner = *grpc_planner_owner;
   RecordSinks records(o, grpc_planner);
   cell::RecordSink& sink = records.sink();
   cell::PlannerClient& planner = records.planner(grpc_planner);
@@ -216,7 +221,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
     const cell::DryRunResult dry = controller.DryRun(0);
     fmt::print("{}", cell::FormatDryRun(dry));
     WriteJson(o.json_path, cell::DryRunJson(dry));
-    StopPlanner(server.get());
+    StopPlanner(server.get(), grpc_planner_owner);
     if (!dry.motions.empty() || dry.bin_empty) return;
     throw CLI::RuntimeError(3);
   }
@@ -257,7 +262,7 @@ void RunOnDevices(const CellOptions& o, const cell::CellControllerParams& base_p
                               {"seed", o.seed},
                               {"rounds", rounds_json},
                               {"statistics", cell::StatisticsJson(stats)}});
-  StopPlanner(server.get());
+  StopPlanner(server.get(), grpc_planner_owner);
   if (stop.signal() != 0) ExitForSignal(stop);
   if (any_fault) throw CLI::RuntimeError(3);
   if (records_lost) throw CLI::RuntimeError(kExitRecordsLost);
@@ -307,7 +312,8 @@ void Run(const CellOptions& o) {
   if (!server && injecting)
     fmt::print("faults: no planner outages (the planner was not started here: --server auto)\n");
   FaultCampaign campaign;
-  cell::GrpcPlannerClient grpc_planner(address, o.planner_options);
+  auto grpc_planner_owner = std::make_unique<cell::GrpcPlannerClient>(address, o.planner_options);
+  cell::GrpcPlannerClient& grpc_planner = *grpc_planner_owner;
   RecordSinks records(o, grpc_planner);
   cell::RecordSink& sink = records.sink();
   cell::PlannerClient& planner = records.planner(grpc_planner);
@@ -380,7 +386,7 @@ void Run(const CellOptions& o) {
                               {"rounds", rounds_json},
                               {"faults", campaign.Json(o.fault_rate, o.fault_seed)},
                               {"statistics", cell::StatisticsJson(stats)}});
-  StopPlanner(server.get());
+  StopPlanner(server.get(), grpc_planner_owner);
   if (stop.signal() != 0) ExitForSignal(stop);
   // A campaign expects safe stops; what it must never see is a tube released outside.
   if (injecting ? campaign.released_outside > 0 : any_fault) throw CLI::RuntimeError(3);
