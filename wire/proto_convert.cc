@@ -140,6 +140,8 @@ v1::ResolutionVariant ToProto(ResolutionVariant variant) {
       return v1::RESOLUTION_VARIANT_PERPENDICULAR;
     case ResolutionVariant::kJointSafe:
       return v1::RESOLUTION_VARIANT_JOINT_SAFE;
+    case ResolutionVariant::kTorqueAxisThenPerpendicular:
+      return v1::RESOLUTION_VARIANT_TORQUE_AXIS_THEN_PERPENDICULAR;
   }
   return v1::RESOLUTION_VARIANT_UNSPECIFIED;
 }
@@ -234,6 +236,8 @@ std::optional<ResolutionVariant> FromProto(v1::ResolutionVariant variant) {
       return ResolutionVariant::kPerpendicular;
     case v1::RESOLUTION_VARIANT_JOINT_SAFE:
       return ResolutionVariant::kJointSafe;
+    case v1::RESOLUTION_VARIANT_TORQUE_AXIS_THEN_PERPENDICULAR:
+      return ResolutionVariant::kTorqueAxisThenPerpendicular;
     default:
       return std::nullopt;
   }

@@ -20,6 +20,7 @@ constexpr VariantName kVariants[] = {
     {v1::RESOLUTION_VARIANT_TORQUE_AXIS, "torque_axis"},
     {v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE, "torque_axis_negative"},
     {v1::RESOLUTION_VARIANT_PERPENDICULAR, "perpendicular"},
+    {v1::RESOLUTION_VARIANT_TORQUE_AXIS_THEN_PERPENDICULAR, "torque_axis_then_perpendicular"},
     {v1::RESOLUTION_VARIANT_JOINT_SAFE, "joint_safe"},
 };
 

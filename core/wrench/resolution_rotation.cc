@@ -146,6 +146,8 @@ std::optional<ResolutionPlan> PlanResolutionRotation(const Wrench& reference, co
   plan.torque_axis_Tcp = plan.delta_torque_Tcp / magnitude;
 
   const double angle = params.rotation_angle;
+  const Eigen::Vector3d perpendicular_Tcp = up_Tcp.cross(plan.torque_axis_Tcp).normalized();
+  constexpr const char* kPerpendicularName = "the horizontal axis perpendicular to the torque";
   switch (params.variant) {
     case ResolutionVariant::kTorqueAxis:
       plan.motions.push_back(Tilt(plan.torque_axis_Tcp, angle, "the torque axis", X_BinTcp));
@@ -153,13 +155,14 @@ std::optional<ResolutionPlan> PlanResolutionRotation(const Wrench& reference, co
     case ResolutionVariant::kTorqueAxisNegative:
       plan.motions.push_back(Tilt(plan.torque_axis_Tcp, -angle, "the torque axis", X_BinTcp));
       break;
-    case ResolutionVariant::kPerpendicular: {
-      const Eigen::Vector3d perpendicular_Tcp = up_Tcp.cross(plan.torque_axis_Tcp).normalized();
-      const std::string name = "the horizontal axis perpendicular to the torque";
-      plan.motions.push_back(Tilt(perpendicular_Tcp, angle, name, X_BinTcp));
-      plan.motions.push_back(Tilt(perpendicular_Tcp, -angle, name, X_BinTcp));
+    case ResolutionVariant::kPerpendicular:
+      plan.motions.push_back(Tilt(perpendicular_Tcp, angle, kPerpendicularName, X_BinTcp));
+      plan.motions.push_back(Tilt(perpendicular_Tcp, -angle, kPerpendicularName, X_BinTcp));
       break;
-    }
+    case ResolutionVariant::kTorqueAxisThenPerpendicular:
+      plan.motions.push_back(Tilt(plan.torque_axis_Tcp, angle, "the torque axis", X_BinTcp));
+      plan.motions.push_back(Tilt(perpendicular_Tcp, angle, kPerpendicularName, X_BinTcp));
+      break;
     case ResolutionVariant::kJointSafe:
       plan.motions.push_back(JointSafe(plan.torque_axis_Tcp, up_Tcp, params, X_BinTcp));
       break;

@@ -41,7 +41,8 @@ struct ResolutionPlan {
   Eigen::Vector3d delta_torque_Tcp = Eigen::Vector3d::Zero();
   /// delta_torque_Tcp normalised: the axis the payload would rotate about if released (Fig. 5.6).
   Eigen::Vector3d torque_axis_Tcp = Eigen::Vector3d::UnitX();
-  /// Alternatives to try in order: kPerpendicular gives +angle then −angle, the others one motion.
+  /// Alternatives to try in order: kPerpendicular gives +angle then −angle,
+  /// kTorqueAxisThenPerpendicular the torque axis then the perpendicular, the others one motion.
   std::vector<ResolutionMotion> motions;
 };
 

@@ -50,6 +50,7 @@ void WrenchParams::Validate() const {
     case ResolutionVariant::kTorqueAxisNegative:
     case ResolutionVariant::kPerpendicular:
     case ResolutionVariant::kJointSafe:
+    case ResolutionVariant::kTorqueAxisThenPerpendicular:
       break;
     default:
       throw InvalidArgument("wrench.variant: unknown value " + std::to_string(static_cast<int>(variant)));
@@ -79,17 +80,21 @@ std::string ToString(ResolutionVariant variant) {
       return "perpendicular";
     case ResolutionVariant::kJointSafe:
       return "joint_safe";
+    case ResolutionVariant::kTorqueAxisThenPerpendicular:
+      return "torque_axis_then_perpendicular";
   }
   return "unknown";
 }
 
 ResolutionVariant ParseResolutionVariant(const std::string& text, const std::string& field) {
   for (ResolutionVariant v : {ResolutionVariant::kTorqueAxis, ResolutionVariant::kTorqueAxisNegative,
-                              ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe}) {
+                              ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe,
+                              ResolutionVariant::kTorqueAxisThenPerpendicular}) {
     if (text == ToString(v)) return v;
   }
   throw InvalidArgument(field + ": unknown resolution variant '" + text +
-                        "' (expected torque_axis, torque_axis_negative, perpendicular or joint_safe)");
+                        "' (expected torque_axis, torque_axis_negative, perpendicular, joint_safe or "
+                        "torque_axis_then_perpendicular)");
 }
 
 std::string ToString(JointSafeFrame frame) {

@@ -432,7 +432,8 @@ TEST(RunAnalyzeWrench, MultipleWithoutATorqueChangeHasNoMotion) {
 
 TEST(ProtoConvert, EnumsRoundTrip) {
   for (const ResolutionVariant v : {ResolutionVariant::kTorqueAxis, ResolutionVariant::kTorqueAxisNegative,
-                                    ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe}) {
+                                    ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe,
+                                    ResolutionVariant::kTorqueAxisThenPerpendicular}) {
     EXPECT_EQ(tubepick::FromProto(ToProto(v)), v);
   }
   EXPECT_EQ(tubepick::FromProto(v1::RESOLUTION_VARIANT_UNSPECIFIED), std::nullopt);

@@ -81,10 +81,11 @@ v1::ResolutionVariant ParseVariant(const std::string& name) {
   if (name == "torque_axis") return v1::RESOLUTION_VARIANT_TORQUE_AXIS;
   if (name == "torque_axis_negative") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE;
   if (name == "perpendicular") return v1::RESOLUTION_VARIANT_PERPENDICULAR;
+  if (name == "torque_axis_then_perpendicular") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_THEN_PERPENDICULAR;
   if (name == "joint_safe") return v1::RESOLUTION_VARIANT_JOINT_SAFE;
   throw InvalidArgument(
       fmt::format("--resolution: unknown variant \"{}\" (torque_axis, torque_axis_negative, "
-                  "perpendicular, joint_safe)",
+                  "perpendicular, joint_safe, torque_axis_then_perpendicular)",
                   name));
 }
 
@@ -462,7 +463,8 @@ void AddCellCommand(CLI::App& app) {
                                          "Planner parameter profile (fast, thesis; default: the server's)");
   CLI::Option* resolution =
       cmd->add_option("--resolution", o->resolution,
-                      "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe "
+                      "Resolution rotation: torque_axis, torque_axis_negative, perpendicular, joint_safe, "
+                      "torque_axis_then_perpendicular "
                       "(default: the server's)");
   cmd->add_flag("--no-sim-planning", o->no_sim_planning, "Ask the planner not to simulate trajectories");
   CLI::Option* plan_deadline =

@@ -402,7 +402,9 @@ void AddResolutionTrialsCommand(CLI::App& app) {
       "Double picks in generated bins of the simulated cell (a tube grasped under another): how often "
       "each resolution rotation frees the extra tubes, and where they fall");
   cmd->add_option("--materials", o->materials, "pvc, rubber")->delimiter(',')->capture_default_str();
-  cmd->add_option("--variants", o->variants, "torque_axis, torque_axis_negative, perpendicular, joint_safe")
+  cmd->add_option(
+         "--variants", o->variants,
+         "torque_axis, torque_axis_negative, perpendicular, joint_safe, torque_axis_then_perpendicular")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--angles", o->angles_deg, "Rotation angles, degrees")

@@ -173,7 +173,8 @@ void AddRequestCommand(CLI::App& app) {
       "--tube-mass", [o](double m) { o->tube_mass = m; },
       "wrench: AnalyzeWrenchRequest.tube_mass, kg (default: the server's cell)");
   cmd->add_option("--variant", o->variant, "wrench: resolution variant")
-      ->check(CLI::IsMember({"TORQUE_AXIS", "TORQUE_AXIS_NEGATIVE", "PERPENDICULAR", "JOINT_SAFE"}));
+      ->check(CLI::IsMember({"TORQUE_AXIS", "TORQUE_AXIS_NEGATIVE", "PERPENDICULAR", "JOINT_SAFE",
+                             "TORQUE_AXIS_THEN_PERPENDICULAR"}));
   cmd->callback([o, seed] {
     o->seed_given = seed->count() > 0;
     Run(*o);

@@ -188,7 +188,8 @@ TEST(WrenchParams, JointSafeAxisMustBeHorizontal) {
 
 TEST(WrenchParams, EnumNamesRoundTrip) {
   for (ResolutionVariant v : {ResolutionVariant::kTorqueAxis, ResolutionVariant::kTorqueAxisNegative,
-                              ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe}) {
+                              ResolutionVariant::kPerpendicular, ResolutionVariant::kJointSafe,
+                              ResolutionVariant::kTorqueAxisThenPerpendicular}) {
     EXPECT_EQ(ParseResolutionVariant(ToString(v), "wrench.variant"), v);
   }
   EXPECT_EQ(ParseJointSafeFrame("bin", "wrench.joint_safe_frame"), JointSafeFrame::kBin);

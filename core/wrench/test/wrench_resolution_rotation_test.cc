@@ -136,6 +136,26 @@ TEST(ResolutionRotation, PerpendicularVariantOffersBothSigns) {
   EXPECT_THAT(plan->motions[0].description, HasSubstr("perpendicular to the torque"));
 }
 
+// The torque axis first (the thesis' motion), then the perpendicular's +angle only: its −angle,
+// after a +angle, swung the payload 110° and threw trees out of the bin in the trials.
+TEST(ResolutionRotation, TorqueAxisThenPerpendicularTiltsAboutBothAxesWithTheSameSign) {
+  WrenchParams params;
+  params.variant = ResolutionVariant::kTorqueAxisThenPerpendicular;
+  params.rotation_angle = 55.0 * kDeg;
+  const std::optional<ResolutionPlan> plan =
+      PlanResolutionRotation(Reference(), Current({0.0, 0.05, 0.0}), Eigen::Isometry3d::Identity(), params);
+  ASSERT_TRUE(plan.has_value());
+  ASSERT_EQ(plan->motions.size(), 2u);
+  EXPECT_TRUE(plan->motions[0].axis_Tcp.isApprox(Eigen::Vector3d::UnitY(), kVectorTol));
+  EXPECT_TRUE(plan->motions[1].axis_Tcp.isApprox(Eigen::Vector3d(-1.0, 0.0, 0.0), kVectorTol));
+  EXPECT_NEAR(plan->motions[0].angle, 55.0 * kDeg, kAngleTol);
+  EXPECT_NEAR(plan->motions[1].angle, 55.0 * kDeg, kAngleTol);
+  EXPECT_TRUE(plan->motions[1].waypoints[0].X_TcpTcpRotated.linear().isApprox(
+      Rotation(55.0 * kDeg, Eigen::Vector3d(-1.0, 0.0, 0.0)), kRotationTol));
+  EXPECT_THAT(plan->motions[0].description, HasSubstr("torque axis"));
+  EXPECT_THAT(plan->motions[1].description, HasSubstr("perpendicular to the torque"));
+}
+
 TEST(ResolutionRotation, JointSafeYawAlignsTorqueWithConfiguredAxis) {
   WrenchParams params;
   params.variant = ResolutionVariant::kJointSafe;
