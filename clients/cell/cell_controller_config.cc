@@ -34,7 +34,8 @@ v1::ResolutionVariant VariantFromName(const std::string& name, const std::string
   for (const VariantName& v : kVariants)
     if (name == v.name) return v.variant;
   throw InvalidArgument(fmt::format(
-      "{}: unknown variant '{}' (unspecified, torque_axis, torque_axis_negative, perpendicular, joint_safe)",
+      "{}: unknown variant '{}' (unspecified, torque_axis, torque_axis_negative, perpendicular, joint_safe, "
+      "torque_axis_then_perpendicular)",
       path, name));
 }
 
@@ -136,7 +137,8 @@ void DescribePlannerFields(Visit& v, CellControllerParams& p) {
     "off");
   v("disable_simulation", p.disable_simulation);
   v.Enum("resolution_variant", p.resolution_variant, VariantToName, VariantFromName,
-         "unspecified (the server's), torque_axis, torque_axis_negative, perpendicular, joint_safe");
+         "unspecified (the server's), torque_axis, torque_axis_negative, perpendicular, joint_safe, "
+         "torque_axis_then_perpendicular");
   v.Seconds("plan_deadline", p.plan_deadline, "s per PlanPick try");
   v.Seconds("analyze_deadline", p.analyze_deadline, "s per AnalyzeWrench try");
 }
