@@ -182,6 +182,10 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
   DescribeLimitFields(v, p);
 }
 
+v1::ResolutionVariant ResolutionVariantFromName(const std::string& name, const std::string& field) {
+  return VariantFromName(name, field);
+}
+
 CellControllerParams ParseCellControllerParams(const std::string& yaml_text) {
   CellControllerParams p;
   ParseFields(yaml_text, "cell controller config", p);

@@ -24,6 +24,10 @@ namespace tubepick::cell {
 /// Parses YAML text over the defaults. @throws InvalidArgument (key path and reason).
 CellControllerParams ParseCellControllerParams(const std::string& yaml_text);
 
+/// The controller's resolution_variant names ("unspecified", "torque_axis", ...,
+/// "torque_axis_then_perpendicular"). @throws InvalidArgument naming `field` and the name.
+v1::ResolutionVariant ResolutionVariantFromName(const std::string& name, const std::string& field);
+
 /// ParseCellControllerParams of the file at `path`. @throws InvalidArgument naming the file.
 CellControllerParams LoadCellControllerParams(const std::string& path);
 

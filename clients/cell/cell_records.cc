@@ -48,15 +48,17 @@ int WriteAll(int fd, const std::string& line) {
 void JsonLinesFileSink::Write(const nlohmann::json& record) {
   const std::string line = record.dump() + '\n';
   const int error = WriteAll(fd_, line);
-  const std::string type = record.contains("type") && record["type"].is_string()
-                               ? record["type"].get<std::string>()
-                               : std::string("record");
+  // The record's type, for the logs only.
+  auto type = [&record] {
+    const auto it = record.find("type");
+    return it != record.end() && it->is_string() ? it->get<std::string>() : std::string("record");
+  };
   if (error == 0) {
     good_size_ += static_cast<std::int64_t>(line.size());
     ++written_;
     if (failing_ > 0)
       spdlog::warn("records file {}: writing again ('{}' record); {} record(s) before it were lost ({})",
-                   path_, type, failing_, last_error_);
+                   path_, type(), failing_, last_error_);
     failing_ = 0;
     return;
   }
@@ -75,7 +77,7 @@ void JsonLinesFileSink::Write(const nlohmann::json& record) {
     spdlog::error(
         "records file {}: '{}' record not written ({}); the cell goes on, and every record lost until "
         "writing works again is counted",
-        path_, type, last_error_);
+        path_, type(), last_error_);
 }
 
 std::string DescribeRecordsFile(const JsonLinesFileSink& sink) {

@@ -77,16 +77,8 @@ struct CellOptions {
 };
 
 v1::ResolutionVariant ParseVariant(const std::string& name) {
-  if (name.empty()) return v1::RESOLUTION_VARIANT_UNSPECIFIED;
-  if (name == "torque_axis") return v1::RESOLUTION_VARIANT_TORQUE_AXIS;
-  if (name == "torque_axis_negative") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_NEGATIVE;
-  if (name == "perpendicular") return v1::RESOLUTION_VARIANT_PERPENDICULAR;
-  if (name == "torque_axis_then_perpendicular") return v1::RESOLUTION_VARIANT_TORQUE_AXIS_THEN_PERPENDICULAR;
-  if (name == "joint_safe") return v1::RESOLUTION_VARIANT_JOINT_SAFE;
-  throw InvalidArgument(
-      fmt::format("--resolution: unknown variant \"{}\" (torque_axis, torque_axis_negative, "
-                  "perpendicular, joint_safe, torque_axis_then_perpendicular)",
-                  name));
+  return name.empty() ? v1::RESOLUTION_VARIANT_UNSPECIFIED
+                      : cell::ResolutionVariantFromName(name, "--resolution");
 }
 
 /// The controller parameters of every round but the seed: --controller (or the defaults), then the
