@@ -181,6 +181,16 @@ TEST(CellCliTest, TubesTenTimesLighterThanTheCellSaysAreNamedThoughEveryLiftRead
       << run.output;
 }
 
+TEST(CellCliTest, AResolutionVariantThatIsNotOneIsRefusedWithTheNames) {
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --resolution sideways");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--resolution: unknown variant 'sideways' (unspecified, torque_axis, "),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("torque_axis_then_perpendicular)"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("round "), std::string::npos) << run.output;  // refused before any round
+}
+
 TEST(CellCliTest, ASimulatedTubeMassOnlyWithSimAndPositive) {
   const testing::CliRun without_sim = RunCli("cell --rounds 1 --sim-tube-mass 0.08");
   EXPECT_NE(without_sim.exit_code, 0) << without_sim.output;

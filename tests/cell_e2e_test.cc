@@ -226,5 +226,66 @@ TEST_F(CellEndToEndTest, TubeThatSlipsInTransitFallsIntoTheBinOrThePlaceZoneAndI
   EXPECT_EQ(r.tubes_in_place_zone, 2u);
 }
 
+TEST_F(CellEndToEndTest, ATubeThatSlipsOntoThePlaceZoneIsLostNotCarriedOutUnnoticed) {
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+  devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
+  // The first transit to the place: the tube slips out 3 s in, over the place zone.
+  bool armed = false;
+  const auto slip_over_the_zone = [&](cell::CellState state) {
+    if (state != cell::CellState::kPlace || armed) return;
+    sim.ArmSlip(3.0);
+    armed = true;
+  };
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, slip_over_the_zone);
+
+  EXPECT_EQ(sim.fault_events().slips, 1u);
+  EXPECT_EQ(r.run.lost, 1u) << r.run.message;
+  EXPECT_EQ(r.run.picks, 1u);
+  EXPECT_EQ(r.tubes_in_bin, 0u);
+  EXPECT_EQ(r.tubes_in_place_zone, 2u);  // the pick, and the lost tube that fell there
+  EXPECT_EQ(r.tubes_unnoticed, 0u);      // the controller recorded it: not carried out unnoticed
+  EXPECT_EQ(r.tubes_elsewhere, 0u);
+}
+
+TEST_F(CellEndToEndTest, TubeCaughtOnTheToolAtThePlaceGoesBackIntoTheBinNotHome) {
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+  devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
+  // The first place: the tube stays hooked on the tool when the gripper opens.
+  bool armed = false;
+  const auto snag_at_place = [&](cell::CellState state) {
+    if (state != cell::CellState::kPlace || armed) return;
+    sim.ArmSnag();
+    armed = true;
+  };
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, snag_at_place);
+
+  ASSERT_TRUE(armed);
+  EXPECT_EQ(sim.fault_events().snags, 1u);
+  ASSERT_TRUE(r.run.fault) << r.run.message;
+  EXPECT_EQ(r.run.fault->device(), "ft_sensor");
+  EXPECT_EQ(r.run.fault->kind(), cell::FaultKind::kUnexpectedLoad);
+  EXPECT_EQ(r.run.fault->state(), "place");
+  EXPECT_EQ(r.run.picks, 0u);
+  ASSERT_TRUE(r.run.safe_stop);
+  EXPECT_EQ(r.run.safe_stop->action, "released_in_bin") << r.run.message;
+  // Back in the bin with the other one: nothing on the place zone, nothing outside, nothing held.
+  EXPECT_EQ(r.tubes_in_bin, 2u);
+  EXPECT_EQ(r.tubes_in_place_zone, 0u);
+  EXPECT_EQ(r.tubes_elsewhere, 0u);
+  EXPECT_EQ(r.tubes_held, 0u);
+  const json& attempt = sink.records().at(0);
+  EXPECT_EQ(attempt["result"], "fault");
+  EXPECT_EQ(attempt["placed"], false);
+  // The tube's weight on the tool after opening, also after lowering it onto the place pose once.
+  const double tube_weight = sim.cell().tube.mass * 9.81;
+  for (const char* key : {"after_place", "after_place_again"}) {
+    const json& f = attempt["wrench"][key]["force"];
+    const double load = Eigen::Vector3d(f[0], f[1], f[2]).norm();
+    EXPECT_NEAR(load, tube_weight, 0.25 * tube_weight) << key;
+  }
+}
+
 }  // namespace
 }  // namespace tubepick

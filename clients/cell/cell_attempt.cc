@@ -301,7 +301,7 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
 
 /// One tube held: transit above the place pose (the gripper's object status checked after every
 /// segment), a reading there that must still weigh a tube, down, the status once more, open, up,
-/// home.
+/// a reading that must weigh nothing (a hose hooked on a pad is not carried home), home.
 void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
                            Attempt& attempt) {
   Enter(CellState::kPlace);
@@ -332,6 +332,7 @@ void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices
   OpenGripper();
   attempt.record["placed"] = true;  // a fault on the way home does not undo the pick
   MoveTo(X_BinTcpAbovePlace, params_.approach_speed, &attempt);
+  CheckToolEmpty(reference, "after_place", X_BinTcpPlace, attempt);
   GoHome(&attempt);
 }
 
@@ -409,8 +410,10 @@ void CellController::CheckToolEmpty(const devices::WrenchReading& reference, con
   };
   std::optional<double> load = load_now(key);
   if (!load) return;
-  spdlog::warn("cell: round {}: {:.2f} N on the tool after it let go ({}): lowering it into the bin once",
-               round_, *load, key);
+  const bool placing = state_ == CellState::kPlace;
+  const char* lowered = placing ? "onto the place pose" : "into the bin";
+  spdlog::warn("cell: round {}: {:.2f} N on the tool after it let go ({}): lowering it {} once", round_,
+               *load, key, lowered);
   const Eigen::Isometry3d X_BinTcpUp = CurrentPose();
   MoveTo(X_BinTcpShed, params_.approach_speed, &attempt);
   MoveTo(X_BinTcpUp, params_.approach_speed, &attempt);
@@ -418,14 +421,15 @@ void CellController::CheckToolEmpty(const devices::WrenchReading& reference, con
   if (!load) return;
   held_ = Held::kUnknown;
   caught_reference_ = reference;
+  // What still hangs on the tool is (part of) the tube the place let go: not placed.
+  if (placing) attempt.record["placed"] = false;
   const double tube_weight = cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
   const Eigen::Vector3d p = X_BinTcpUp.translation();
-  throw CellFault(
-      "ft_sensor", FaultKind::kUnexpectedLoad, ToString(state_),
-      fmt::format("the tool carries {:.2f} N ({:.1f} times a tube's weight) after letting go, at "
-                  "X_BinTcp ({:.3f}, {:.3f}, {:.3f}) m, also after lowering it into the bin once: a "
-                  "tube caught on the pads or the housing?",
-                  *load, *load / tube_weight, p.x(), p.y(), p.z()));
+  throw CellFault("ft_sensor", FaultKind::kUnexpectedLoad, ToString(state_),
+                  fmt::format("the tool carries {:.2f} N ({:.1f} times a tube's weight) after letting go, at "
+                              "X_BinTcp ({:.3f}, {:.3f}, {:.3f}) m, also after lowering it {} once: a "
+                              "tube caught on the pads or the housing?",
+                              *load, *load / tube_weight, p.x(), p.y(), p.z(), lowered));
 }
 
 std::optional<double> CellController::LoadOnTool(const devices::WrenchReading& reference,

@@ -419,12 +419,13 @@ class CellController {
   /// Several tubes held after every resolution motion: lower them back into the bin and open.
   void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
                const devices::WrenchReading& reference, Attempt& attempt);
-  /// Before the tool leaves the bin empty-handed (after a failed grasp, a put-back, a nudge): a
-  /// reading against `reference` (the same gripper opening and orientation) that must weigh
-  /// nothing, into record["wrench"][key]. A tube caught on the pads or the housing is not carried
-  /// home: the tool goes down to `X_BinTcpShed` (where it just was, inside the bin) and back up
-  /// once; still loaded, it throws CellFault (ft_sensor, unexpected_load) with the tool over the
-  /// bin and held_ unknown, so the safe stop lowers it over the bin's middle and opens there.
+  /// Before the tool goes home empty-handed (after a failed grasp, a put-back, a nudge, the place):
+  /// a reading against `reference` (the same gripper opening and, but for a turn about the
+  /// vertical, orientation) that must weigh nothing, into record["wrench"][key]. A tube caught on
+  /// the pads or the housing is not carried home: the tool goes down to `X_BinTcpShed` (where it
+  /// just opened: inside the bin, or the place pose) and back up once; still loaded, it throws
+  /// CellFault (ft_sensor, unexpected_load) with held_ unknown (and, after the place, "placed"
+  /// false), so the safe stop carries it over the bin's middle, lowers it and opens there.
   void CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
                       const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt);
   /// The force `now` adds to `reference` (the same opening and orientation: whatever the tilt, a

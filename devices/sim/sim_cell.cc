@@ -255,6 +255,7 @@ void SimCell::InjectFaultOnce(SimDevice device, SimFault fault) {
 
 void SimCell::ArmRobotAlarm(double seconds) { impl_->state.robot_alarm_in = std::max(0.0, seconds); }
 void SimCell::ArmSlip(double seconds) { impl_->state.slip_in = std::max(0.0, seconds); }
+void SimCell::ArmSnag() { impl_->state.snag_next_open = true; }
 void SimCell::InjectFtSpike() { impl_->state.ft_spike_next = true; }
 void SimCell::InjectEmptyScan() { impl_->state.empty_scan_next = true; }
 const SimFaultEvents& SimCell::fault_events() const { return impl_->state.events; }

@@ -217,6 +217,7 @@ enum class SimFault {
 struct SimFaultEvents {
   std::uint32_t robot_alarms = 0;
   std::uint32_t slips = 0;  ///< a tube was held and fell
+  std::uint32_t snags = 0;  ///< an opening left what was held hanging on the tool
   std::uint32_t ft_spikes = 0;
   std::uint32_t empty_scans = 0;
   std::uint32_t device_failures = 0;  ///< calls that failed by InjectFault / InjectFaultOnce
@@ -307,6 +308,10 @@ class SimCell {
   /// world (a grip gives way while the tube is moved, not while it hangs still); the gripper then
   /// reports no object. Opening the gripper first disarms it.
   void ArmSlip(double seconds);
+  /// The next opening of the gripper while it holds something leaves it hanging on the tool (a hose
+  /// hooked over a pad or caught on the housing): the fingers open and report no object, the F/T
+  /// sensor still feels the load, and it goes with the tool until the gripper opens again.
+  void ArmSnag();
   /// The next F/T reading carries a 25 N spike along z (a hit cable, an EMI burst).
   void InjectFtSpike();
   /// The next scan returns no point (a projector or exposure failure).

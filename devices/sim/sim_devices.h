@@ -33,6 +33,8 @@ struct SimCellState {
   /// Armed events (SimCell::ArmRobotAlarm / ArmSlip): simulated seconds until they happen, < 0 = none.
   double robot_alarm_in = -1.0;
   double slip_in = -1.0;
+  /// SimCell::ArmSnag: the next opening while holding keeps what is held on the tool.
+  bool snag_next_open = false;
   bool ft_spike_next = false;
   bool empty_scan_next = false;
   SimFaultEvents events;

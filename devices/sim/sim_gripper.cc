@@ -58,7 +58,12 @@ GripperStatus SimGripper::MoveTo(double opening, double speed, double force, Tim
 
   double current = world.opening();
   if (target >= current) {  // opening (or staying): let go of whatever is held
-    world.ReleaseAll();
+    if (state_.snag_next_open && world.holding()) {
+      state_.snag_next_open = false;  // caught on the tool: it stays, whatever the fingers do
+      ++state_.events.snags;
+    } else {
+      world.ReleaseAll();
+    }
     state_.slip_in = -1.0;
     state_.gripper_object = GripperObject::kAtPosition;
     while (current < target) {

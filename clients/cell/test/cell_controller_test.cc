@@ -752,9 +752,9 @@ TEST_F(CellControllerTest, RobotFaultDuringANudgeEndsInSafeStopAndIsRecorded) {
 
 TEST_F(CellControllerTest, ATubeCaughtOnTheToolAfterANudgeIsNotCarriedHome) {
   // The reference above the press, then 0.60 N more after the push, and still after lowering the
-  // tool into the bin once: a hose hooked over a pad.
+  // tool into the bin once, and when the safe stop has opened over the bin: a hose hooked over a pad.
   planner.plan_answers.push_back(WallTubeWithoutPlan());
-  ft.readings = {Reading(0.02), Reading(0.62), Reading(0.62)};
+  ft.readings = {Reading(0.02), Reading(0.62), Reading(0.62), Reading(0.62)};
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kFault);
@@ -765,7 +765,7 @@ TEST_F(CellControllerTest, ATubeCaughtOnTheToolAfterANudgeIsNotCarriedHome) {
   EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("carries 0.60 N (1.1 times a tube's weight)"));
   EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("caught on the pads or the housing"));
   // Not carried home: the safe stop lowered it over the bin's middle and opened there; the load
-  // still hangs on the tool (the last reading again), so the arm stays there, inside the bin.
+  // still hangs on the tool (the fourth reading), so the arm stays there, inside the bin.
   ASSERT_TRUE(result.safe_stop);
   EXPECT_EQ(result.safe_stop->held, Held::kUnknown);
   EXPECT_EQ(result.safe_stop->action, "load_on_tool");
@@ -804,7 +804,7 @@ TEST_F(CellControllerTest, ALoadThatStaysInTheBinWhenTheToolIsLoweredLetsTheRoun
 TEST_F(CellControllerTest, ATubeCaughtOnTheOpenFingersAfterAFailedGraspIsNotCarriedHome) {
   planner.plan_answers.push_back(Plans({MakePlan(0, p_Bin_grasp)}, 1));
   gripper.close_results.push_back(ClosedOnNothing());
-  ft.readings = {Reading(0.02), Reading(0.60), Reading(0.60)};
+  ft.readings = {Reading(0.02), Reading(0.60), Reading(0.60), Reading(0.60)};
 
   const CellRunResult result = Run();
   ASSERT_TRUE(result.fault);
@@ -1138,6 +1138,49 @@ TEST_F(PlaceFaultTest, RobotAlarmOnTheDescentKeepsTheTubeOverThePlaceZone) {
             std::string::npos)
       << result.message;
   EXPECT_EQ(result.picks, 0u);
+}
+
+TEST_F(PlaceFaultTest, ATubeCaughtOnThePadsAfterThePlaceIsCarriedBackIntoTheBinNotHome) {
+  // Above the place after opening: still 0.54 N on the tool, also after lowering it onto the place
+  // pose once; it comes off when the safe stop opens over the bin.
+  ft.readings.insert(ft.readings.end(), {Reading(0.64), Reading(0.64), Reading(0.10)});
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.fault);
+  EXPECT_EQ(result.fault->device(), "ft_sensor");
+  EXPECT_EQ(result.fault->kind(), FaultKind::kUnexpectedLoad);
+  EXPECT_EQ(result.fault->state(), "place");
+  EXPECT_THAT(result.fault->error(), ::testing::HasSubstr("carries 0.54 N (1.0 times a tube's weight) after "
+                                                          "letting go, at X_BinTcp (0.000, 0.800, 0.220) m, "
+                                                          "also after lowering it onto the place pose once"));
+  EXPECT_EQ(result.picks, 0u);
+  // Lowered onto the place pose twice (the place, the shed), then over the bin's middle.
+  int at_place = 0;
+  for (const auto& m : robot.moves) at_place += m.X_BinTcpTarget.isApprox(testing::PlacePose(), kTol);
+  EXPECT_EQ(at_place, 2);
+  EXPECT_TRUE(robot.X_BinTcp.translation().head<2>().isZero(kTol));  // up out of the bin's middle
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->held, Held::kUnknown);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  ASSERT_EQ(gripper.opened_at.size(), 3u);  // the start, the place, over the bin
+  EXPECT_TRUE(gripper.opened_at[2].isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "fault");
+  EXPECT_EQ(a["placed"], false);
+  EXPECT_NEAR(a["wrench"]["after_place"]["force"][2].get<double>(), 0.64, kTol);
+  EXPECT_NEAR(a["wrench"]["after_place_again"]["force"][2].get<double>(), 0.64, kTol);
+  EXPECT_EQ(Records("end").at(0)["picks"], 0);
+}
+
+TEST_F(PlaceFaultTest, AHoseThatComesOffWhenLoweredOntoThePlaceAgainIsAPick) {
+  ft.readings.insert(ft.readings.end(), {Reading(0.64), Reading(0.11)});  // 0.01 N off: noise
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_TRUE(robot.X_BinTcp.isApprox(HomePose(params, cell), kTol));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "picked");
+  EXPECT_EQ(a["placed"], true);
+  EXPECT_TRUE(a["wrench"].contains("after_place_again"));
 }
 
 TEST_F(PlaceFaultTest, RobotAlarmAfterTheTubeIsPlacedStillCountsThePick) {

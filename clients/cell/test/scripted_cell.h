@@ -186,7 +186,9 @@ class ScriptedGripper final : public devices::Gripper {
 
 class ScriptedForceTorque final : public devices::ForceTorqueSensor {
  public:
-  /// Readings in order; when they run out, the last one again.
+  /// Readings in order; when they run out, the last one again while the gripper holds (or when
+  /// `holding` is not set): the load has not changed. Once the gripper has let go, what is not
+  /// scripted follows the gripper (an empty tool reads zero).
   std::deque<devices::WrenchReading> readings;
   devices::WrenchReading last;
   bool queued = false;
@@ -205,7 +207,7 @@ class ScriptedForceTorque final : public devices::ForceTorqueSensor {
     if (fail_read_from && i >= *fail_read_from) failure.Throw();
     if (std::find(fail_once_at.begin(), fail_once_at.end(), i) != fail_once_at.end()) failure.Throw();
     if (readings.empty()) {
-      if (queued) return last;   // the load has not changed since the last scripted reading
+      if (queued && (!holding || *holding)) return last;  // the load has not changed
       devices::WrenchReading r;  // nothing scripted: the load follows what the gripper holds
       if (holding && *holding) r.force.z() = held_force;
       return r;

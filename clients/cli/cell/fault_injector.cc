@@ -27,9 +27,12 @@ std::vector<std::string> KindsFor(CellState state, bool holding, bool planner) {
     case CellState::kApproach:
     case CellState::kHome:
     case CellState::kRelease:
-    case CellState::kReturnToBin:
     case CellState::kNudge:
       add("robot_alarm");
+      break;
+    case CellState::kReturnToBin:
+      add("robot_alarm");
+      if (holding) add("snag");
       break;
     case CellState::kGrasp:
       add("robot_alarm");
@@ -64,6 +67,7 @@ std::vector<std::string> KindsFor(CellState state, bool holding, bool planner) {
       add("ft_timeout");
       add("ft_lost");
       if (holding) add("slip");
+      if (holding) add("snag");
       break;
     case CellState::kStart:
     case CellState::kBias:
@@ -113,6 +117,8 @@ void FaultInjector::Inject(const std::string& kind) {
     sim_.InjectFtSpike();
   } else if (kind == "slip") {
     sim_.ArmSlip(delay(rng_));
+  } else if (kind == "snag") {
+    sim_.ArmSnag();
   } else if (kind == "planner_restart") {
     std::uniform_real_distribution<double> down(0.5, 1.5);
     planner_->Restart(down(rng_));
@@ -127,6 +133,7 @@ std::map<std::string, std::uint32_t> FaultInjector::by_kind() const {
   const devices::sim::SimFaultEvents& events = sim_.fault_events();
   if (counts.count("robot_alarm")) counts["robot_alarm"] = events.robot_alarms;
   if (counts.count("slip")) counts["slip"] = events.slips;
+  if (counts.count("snag")) counts["snag"] = events.snags;
   return counts;
 }
 

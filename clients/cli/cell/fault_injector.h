@@ -15,12 +15,15 @@ namespace tubepick::cli {
 /// moments of the controller's state machine: on every state the controller enters, with
 /// probability `rate`, one fault that fits the state, drawn uniformly:
 ///   scan: scanner timeout, empty scan · plan: planner restart, planner outage · approach, home,
-///   release, return_to_bin, nudge: robot alarm · grasp: robot alarm, gripper fault · reference: F/T
-///   timeout, F/T spike, F/T lost · lift: robot alarm, gripper fault, slip · analyze: F/T timeout,
-///   F/T spike, F/T lost, planner restart, planner outage, slip · resolve: robot alarm, F/T spike,
-///   slip · place: robot alarm, gripper fault, F/T timeout, F/T lost, slip.
+///   release, nudge: robot alarm · return_to_bin: robot alarm, snag · grasp: robot alarm, gripper
+///   fault · reference: F/T timeout, F/T spike, F/T lost · lift: robot alarm, gripper fault, slip ·
+///   analyze: F/T timeout, F/T spike, F/T lost, planner restart, planner outage, slip · resolve:
+///   robot alarm, F/T spike, slip · place: robot alarm, gripper fault, F/T timeout, F/T lost, slip,
+///   snag.
 /// Robot alarms and slips happen after a random 0-2 s of further robot motion (a slip falls in the
-/// Bullet world wherever the gripper is then); a slip is only drawn while a tube is held. Robot
+/// Bullet world wherever the gripper is then); a slip is only drawn while a tube is held. A snag
+/// (SimCell::ArmSnag) keeps the held tube on the tool when the gripper next opens (on the place
+/// pose, or putting several back into the bin), until it opens again; drawn only while holding. Robot
 /// alarms and gripper faults stay until the round ends, and so does "F/T lost" (every reading times
 /// out: an unplugged cable); timeouts, spikes and empty scans hit one call. A planner restart kills
 /// the server and starts it again 0.5-1.5 s later (the client's ~5 s of retries ride it out); a
@@ -35,7 +38,7 @@ class FaultInjector {
   /// The controller's state observer.
   void OnState(cell::CellState state);
 
-  /// Faults that took effect: armed ones, except robot alarms and slips that never came due.
+  /// Faults that took effect: armed ones, except robot alarms, slips and snags that never came due.
   std::uint32_t injected() const;
   /// The same by kind ("robot_alarm", "slip", "gripper_fault", ...).
   std::map<std::string, std::uint32_t> by_kind() const;

@@ -66,9 +66,10 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& 
   result.tubes_in_place_zone = sim.TubesInPlaceZone();
   result.tubes_elsewhere = sim.TubesElsewhere();
   result.tubes_held = static_cast<std::uint32_t>(sim.HeldTubes().size());
-  // Carried-off tubes keep their last pose over the zone, so they count in tubes_in_place_zone.
-  result.tubes_unnoticed =
-      result.tubes_in_place_zone > result.run.picks ? result.tubes_in_place_zone - result.run.picks : 0;
+  // Carried-off tubes keep their last pose over the zone, so they count in tubes_in_place_zone. A
+  // tube recorded as lost may have fallen onto the zone: the controller knew of it.
+  const std::uint32_t known = result.run.picks + result.run.lost;
+  result.tubes_unnoticed = result.tubes_in_place_zone > known ? result.tubes_in_place_zone - known : 0;
   result.simulated_s = sim.SimulatedSeconds();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;

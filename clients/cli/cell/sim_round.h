@@ -28,8 +28,9 @@ struct SimRoundResult {
   std::uint32_t tubes_elsewhere = 0;
   /// Tubes the gripper still holds (a safe stop that could not release).
   std::uint32_t tubes_held = 0;
-  /// Tubes on the place zone (or carried off it) beyond the picks: carried out of the bin without
-  /// the controller knowing (a second tube the F/T took for none, one caught on the tool).
+  /// Tubes on the place zone (or carried off it) beyond the picks and the tubes recorded as lost
+  /// (which may have fallen there): carried out of the bin without the controller knowing (a
+  /// second tube the F/T took for none, one caught on the tool).
   std::uint32_t tubes_unnoticed = 0;
   /// Simulated seconds of the round and the wall time it took (cell construction included).
   double simulated_s = 0.0;

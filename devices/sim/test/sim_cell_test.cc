@@ -212,6 +212,29 @@ TEST(SimCell, ArmedSlipDropsTheHeldTubeMidMotionAndTheGripperSaysSo) {
   EXPECT_EQ(cell.TubesElsewhere(), 0u);
 }
 
+TEST(SimCell, ASnaggedTubeStaysOnTheOpenToolUntilItOpensAgain) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  GraspAndLift(cell);
+  cell.ft_sensor().Bias(kLong);  // zero with the tube held: its weight reads as the loss of it
+  cell.ArmSnag();
+  const GripperStatus opened = cell.gripper().Open(kLong);
+  EXPECT_EQ(opened.object, GripperObject::kAtPosition);  // the fingers opened: no object
+  EXPECT_GT(opened.opening, 0.05);
+  EXPECT_EQ(cell.fault_events().snags, 1u);
+  cell.Advance(1.0);
+  ASSERT_EQ(cell.HeldTubes().size(), 1u);  // but the tube still hangs on the tool
+  EXPECT_EQ(cell.TubesInBin(), 0u);
+  EXPECT_NEAR(cell.ft_sensor().Read(kLong).force.z(), 0.0, kForceTol);  // the load has not changed
+  // Opening again sheds it: it falls back into the bin.
+  cell.gripper().Open(kLong);
+  EXPECT_TRUE(cell.HeldTubes().empty());
+  EXPECT_NEAR(cell.ft_sensor().Read(kLong).force.z(), -params.cell.tube.mass * kG, kForceTol);
+  cell.Advance(2.0);
+  EXPECT_EQ(cell.TubesInBin(), 1u);
+  EXPECT_EQ(cell.fault_events().snags, 1u);  // armed once: the second opening let go
+}
+
 TEST(SimCell, TubeDroppedBesideThePlaceZoneCountsAsElsewhere) {
   SimCellParams params;
   SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
