@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
 #include <string>
 
 #include "clients/cell/cell_controller.h"
@@ -19,6 +20,15 @@ namespace tubepick {
 namespace {
 
 using nlohmann::json;
+
+/// A state observer that calls `arm` the first time the controller enters the place.
+std::function<void(cell::CellState)> OnFirstPlace(std::function<void()> arm) {
+  return [arm = std::move(arm), done = false](cell::CellState state) mutable {
+    if (state != cell::CellState::kPlace || done) return;
+    arm();
+    done = true;
+  };
+}
 
 class CellEndToEndTest : public ::testing::Test {
  protected:
@@ -203,16 +213,10 @@ TEST_F(CellEndToEndTest, TubeThatSlipsInTransitFallsIntoTheBinOrThePlaceZoneAndI
   cell::MemoryRecordSink sink;
   devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
   // The first transit to the place: the tube slips out 1.2 s in (moving across at transit height).
-  bool armed = false;
-  const auto slip_in_transit = [&](cell::CellState state) {
-    if (state != cell::CellState::kPlace || armed) return;
-    sim.ArmSlip(1.2);
-    armed = true;
-  };
-  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, slip_in_transit);
+  const cli::SimRoundResult r =
+      cli::RunSimRound(planner, sim, {}, 0, &sink, OnFirstPlace([&] { sim.ArmSlip(1.2); }));
 
-  ASSERT_TRUE(armed);
-  EXPECT_EQ(sim.fault_events().slips, 1u);
+  ASSERT_EQ(sim.fault_events().slips, 1u);
   EXPECT_EQ(r.run.lost, 1u) << r.run.message;
   EXPECT_EQ(r.tubes_elsewhere, 0u);  // it fell back into the bin or onto the place zone
   EXPECT_EQ(r.tubes_held, 0u);
@@ -231,15 +235,10 @@ TEST_F(CellEndToEndTest, ATubeThatSlipsOntoThePlaceZoneIsLostNotCarriedOutUnnoti
   cell::MemoryRecordSink sink;
   devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
   // The first transit to the place: the tube slips out 3 s in, over the place zone.
-  bool armed = false;
-  const auto slip_over_the_zone = [&](cell::CellState state) {
-    if (state != cell::CellState::kPlace || armed) return;
-    sim.ArmSlip(3.0);
-    armed = true;
-  };
-  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, slip_over_the_zone);
+  const cli::SimRoundResult r =
+      cli::RunSimRound(planner, sim, {}, 0, &sink, OnFirstPlace([&] { sim.ArmSlip(3.0); }));
 
-  EXPECT_EQ(sim.fault_events().slips, 1u);
+  ASSERT_EQ(sim.fault_events().slips, 1u);
   EXPECT_EQ(r.run.lost, 1u) << r.run.message;
   EXPECT_EQ(r.run.picks, 1u);
   EXPECT_EQ(r.tubes_in_bin, 0u);
@@ -253,16 +252,10 @@ TEST_F(CellEndToEndTest, TubeCaughtOnTheToolAtThePlaceGoesBackIntoTheBinNotHome)
   cell::MemoryRecordSink sink;
   devices::sim::SimCell sim(devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 2, 3));
   // The first place: the tube stays hooked on the tool when the gripper opens.
-  bool armed = false;
-  const auto snag_at_place = [&](cell::CellState state) {
-    if (state != cell::CellState::kPlace || armed) return;
-    sim.ArmSnag();
-    armed = true;
-  };
-  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, {}, 0, &sink, snag_at_place);
+  const cli::SimRoundResult r =
+      cli::RunSimRound(planner, sim, {}, 0, &sink, OnFirstPlace([&] { sim.ArmSnag(); }));
 
-  ASSERT_TRUE(armed);
-  EXPECT_EQ(sim.fault_events().snags, 1u);
+  ASSERT_EQ(sim.fault_events().snags, 1u);
   ASSERT_TRUE(r.run.fault) << r.run.message;
   EXPECT_EQ(r.run.fault->device(), "ft_sensor");
   EXPECT_EQ(r.run.fault->kind(), cell::FaultKind::kUnexpectedLoad);
