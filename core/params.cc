@@ -85,6 +85,10 @@ Params ProfileParams(const std::string& name) {
     // of generated set-C pvc bins, carried over the bin's middle first, 55° freed 19 and 45° 13
     // (`tubepick resolution-trials`, docs/ACCURACY.md).
     p.wrench.rotation_angle = 55.0 * M_PI / 180.0;
+    // And when several still hang, 55° about the horizontal perpendicular to the torque axis: on
+    // those 33 double picks 23 freed against 19 with no tree outside the bin, and in six 20-tree
+    // set-C cell rounds 6 of 9 resolutions freed one tree against 6 of 11 (docs/ACCURACY.md).
+    p.wrench.variant = ResolutionVariant::kTorqueAxisThenPerpendicular;
   } else if (name == "thesis") {
     p.modeling = ThesisModelingProfile();
   } else {

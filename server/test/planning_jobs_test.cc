@@ -378,7 +378,9 @@ TEST(RunAnalyzeWrench, ThreeTubesGiveARotationAboutTheTcp) {
   ASSERT_TRUE(r.has_delta_torque_tcp());
   EXPECT_LT((FromProto(r.delta_torque_tcp()) - Eigen::Vector3d(0.08, -0.06, 0.0)).norm(), 1e-12);
 
-  ASSERT_EQ(r.resolution_motions_size(), 1);  // the profile's variant: torque_axis
+  // The profile's variant, torque_axis_then_perpendicular: about the torque axis, then (several
+  // still hanging) about the horizontal axis perpendicular to it, by the same angle.
+  ASSERT_EQ(r.resolution_motions_size(), 2);
   const v1::ResolutionMotion& m = r.resolution_motions(0);
   const Eigen::Vector3d axis(0.8, -0.6, 0.0);
   EXPECT_LT((FromProto(m.axis_tcp()) - axis).norm(), 1e-12);
@@ -394,6 +396,12 @@ TEST(RunAnalyzeWrench, ThreeTubesGiveARotationAboutTheTcp) {
   EXPECT_LT((FromProto(pose.position()) - GraspTcp().translation()).norm(), 1e-12);
   const Eigen::Matrix3d expected = GraspTcp().linear() * Eigen::AngleAxisd(angle, axis).toRotationMatrix();
   EXPECT_TRUE(FromProto(pose.orientation()).toRotationMatrix().isApprox(expected, 1e-12));
+  const v1::ResolutionMotion& second = r.resolution_motions(1);
+  const Eigen::Vector3d perpendicular = FromProto(second.axis_tcp());
+  EXPECT_NEAR(perpendicular.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(perpendicular.dot(axis), 0.0, 1e-12);
+  EXPECT_NEAR(perpendicular.z(), 0.0, 1e-12);  // horizontal
+  EXPECT_NEAR(second.angle(), angle, 1e-12);
 }
 
 TEST(RunAnalyzeWrench, VariantsOfTheRequestAreUsed) {

@@ -49,11 +49,11 @@ TEST(Params, TheFastProfileJoinsHiddenGapsUpTo18CentimetresWithinTheCellsTubeLen
   EXPECT_DOUBLE_EQ(j.max_tube_length, 0.60);
 }
 
-TEST(Params, TheResolutionRotatesTheThesis45DegreesOr55InTheFastProfile) {
+TEST(Params, TheResolutionRotatesTheThesis45DegreesOr55InTheFastProfileThenAboutThePerpendicular) {
   EXPECT_NEAR(ProfileParams("thesis").wrench.rotation_angle, 45.0 * M_PI / 180.0, 1e-15);  // Table 5.3
   EXPECT_NEAR(ProfileParams("fast").wrench.rotation_angle, 55.0 * M_PI / 180.0, 1e-15);
   EXPECT_EQ(ProfileParams("thesis").wrench.variant, ResolutionVariant::kTorqueAxis);  // §5.2.6
-  EXPECT_EQ(ProfileParams("fast").wrench.variant, ResolutionVariant::kTorqueAxis);
+  EXPECT_EQ(ProfileParams("fast").wrench.variant, ResolutionVariant::kTorqueAxisThenPerpendicular);
 }
 
 TEST(Params, DumpRoundTrips) {
