@@ -79,6 +79,8 @@ template <typename Visit>
 void DescribeFields(Visit& v, CellFrameCheckParams& c) {
   v("enabled", c.enabled, "check every plan against this controller's cell before any motion");
   v("bin_margin", c.bin_margin, "m: grasp in the bin's interior, pre-grasp and lift over it, grown by this");
+  v("grasp_above_walls", c.grasp_above_walls,
+    "m: the grasp also up to this above the wall top, for a heap meant to rise above the walls");
   v("place_position_tolerance", c.place_position_tolerance,
     "m between the place frame a plan implies and this cell's place frame");
   v("place_rotation_tolerance", c.place_rotation_tolerance,

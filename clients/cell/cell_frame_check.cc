@@ -32,13 +32,16 @@ std::string MillimetresCause() {
          "in mm (sensor.unit, the request's cloud unit)?";
 }
 
-/// Why `p_Bin` (the TCP at `what`) is outside the bin, or "".
+/// Why `p_Bin` (the TCP at `what`) is outside the bin, or "". With `above_walls` (≥ 0), it must
+/// also lie at most that far above the wall top (plus the margin); negative: no bound above.
 std::string OutsideBin(const Eigen::Vector3d& p_Bin, const std::string& what, const CellConfig& cell,
-                       double margin, bool below_wall_top) {
+                       double margin, double above_walls) {
   const Eigen::Vector3d& size = cell.bin.inner_size;
   const double x_max = 0.5 * size.x() + margin, y_max = 0.5 * size.y() + margin;
-  const double z_min = -margin, z_max = size.z() + margin;
+  const double z_min = -margin, z_max = size.z() + above_walls + margin;
+  const bool below_wall_top = above_walls >= 0.0;
   std::string bound;
+  bool too_high = false;
   if (!p_Bin.allFinite())
     bound = "not finite";
   else if (std::abs(p_Bin.x()) > x_max)
@@ -47,14 +50,19 @@ std::string OutsideBin(const Eigen::Vector3d& p_Bin, const std::string& what, co
     bound = fmt::format("|y| > {:.3f} m", y_max);
   else if (p_Bin.z() < z_min)
     bound = fmt::format("z < {:.3f} m (below the floor)", z_min);
-  else if (below_wall_top && p_Bin.z() > z_max)
-    bound = fmt::format("z > {:.3f} m (above the wall top)", z_max);
+  else if ((too_high = below_wall_top && p_Bin.z() > z_max))
+    bound = fmt::format("z > {:.3f} m, {:.3f} m above the wall top (cell_check.grasp_above_walls {:.3f} m)",
+                        z_max, p_Bin.z() - size.z(), above_walls);
   if (bound.empty()) return "";
-  const std::string cause =
+  std::string cause =
       LooksLikeMillimetres(p_Bin, cell)
           ? MillimetresCause()
-          : "the planner is likely configured with another bin (cell bin.inner_size) or sensor pose "
-            "(sensor.pose_in_bin) than this controller";
+          : "the planner is likely configured with another bin (cell bin.inner_size) or sensor "
+            "pose (sensor.pose_in_bin) than this controller";
+  if (too_high && !LooksLikeMillimetres(p_Bin, cell))
+    cause +=
+        "; or a tube lies that high: leaning on a wall, partly outside the bin, or on a heap above the "
+        "walls (clear it by hand; cell_check.grasp_above_walls allows a heap meant to rise above them)";
   return fmt::format(
       "cell check: the {} at {} lies outside this controller's bin (inner {:.3f} x {:.3f} x {:.3f} m, "
       "bin_margin {:.3f} m: {}); {}",
@@ -183,6 +191,7 @@ void RequireNonNegative(double value, const char* field) {
 
 void CellFrameCheckParams::Validate() const {
   RequireNonNegative(bin_margin, "bin_margin");
+  RequireNonNegative(grasp_above_walls, "grasp_above_walls");
   RequireNonNegative(place_position_tolerance, "place_position_tolerance");
   if (!std::isfinite(place_rotation_tolerance) || place_rotation_tolerance < 0.0 ||
       place_rotation_tolerance > M_PI)
@@ -195,12 +204,12 @@ std::optional<std::string> CellFrameProblem(const CellConfig& cell, const CellFr
                                             const PlanFrameInput& plan) {
   if (!params.enabled) return std::nullopt;
   const Eigen::Vector3d p_Bin_grasp = plan.X_BinTcpGrasp.translation();
-  std::string problem = OutsideBin(p_Bin_grasp, "grasp", cell, params.bin_margin, true);
+  std::string problem = OutsideBin(p_Bin_grasp, "grasp", cell, params.bin_margin, params.grasp_above_walls);
   if (problem.empty())
-    problem = OutsideBin(plan.X_BinTcpPreGrasp.translation(), "pre-grasp", cell, params.bin_margin, false);
+    problem = OutsideBin(plan.X_BinTcpPreGrasp.translation(), "pre-grasp", cell, params.bin_margin, -1.0);
   for (std::size_t i = 0; problem.empty() && i < plan.waypoints_Bin.size(); ++i)
     problem = OutsideBin(p_Bin_grasp + plan.waypoints_Bin[i], fmt::format("lift waypoint {}", i), cell,
-                         params.bin_margin, false);
+                         params.bin_margin, -1.0);
   if (!problem.empty()) return problem;
   if (plan.X_BinTcpPlace) return PlaceProblem(cell, params, plan);
   return std::nullopt;

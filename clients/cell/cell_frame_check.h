@@ -18,10 +18,19 @@ namespace tubepick::cell {
 struct CellFrameCheckParams {
   /// Check at all (false: plans are only checked against the robot's limits and the tool clearance).
   bool enabled = true;
-  /// The grasp must lie inside the bin's interior (floor to wall top), the pre-grasp pose and the
+  /// The grasp must lie inside the bin's interior (floor to wall top; see grasp_above_walls), the
+  /// pre-grasp pose and the
   /// lift waypoints above the floor and over the bin's inner footprint, each grown by this margin,
   /// metres.
   double bin_margin = 0.02;
+  /// The grasp may also lie up to this far above the wall top (plus bin_margin), over the bin's
+  /// inner footprint, for a cell whose heap is meant to rise above the walls (the modeling's crop
+  /// box sees 0.3 m above them). 0 by default: a tube that high is as likely one leaning on a wall,
+  /// partly outside the bin, as the top of a heap. In a simulated 20-tree bin (docs/ACCURACY.md)
+  /// such a tree, grasped 0.12 m above the wall top with 0.3 allowed, caught on the wall on the way
+  /// to the place (4437 N on the F/T) and ended in a safe stop; refused, it is named for the
+  /// operator.
+  double grasp_above_walls = 0.0;
   /// The place frame that the plan's place pose implies (the planner lays the tube frame it
   /// estimated on its own place frame) must lie this close to the controller's
   /// (CellConfig::place), metres. The controller has the tube's model, not the planner's points:

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
@@ -196,25 +197,12 @@ struct WorkingCloud {
   }
 };
 
-}  // namespace
-
-ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params, const StopToken* stop) {
-  if (input.points_Sensor != nullptr && !input.xyz_Sensor.bytes.empty()) {
-    throw std::invalid_argument("ModelingInput: both points_Sensor and xyz_Sensor are set");
-  }
-  if (input.xyz_Sensor.bytes.size() % 12 != 0) {
-    throw InvalidArgument("cloud: " + std::to_string(input.xyz_Sensor.bytes.size()) +
-                          " bytes is not a multiple of 12 (packed float32 x, y, z per point)");
-  }
-  params.Validate();
-  RequireRadiusWithinFit(input.tube_radius, params.cylinders);
-  const Clock::time_point t_start = Clock::now();
-  ModelingResult result;
-
-  // 1. Prepare, in one pass over the input: units, NaN removal, bin frame, the cloud-vs-cell
-  // evidence and a leading crop box (the rest of the filter chain then sees only the crop).
-  Clock::time_point t0 = Clock::now();
-  const FilterContext context{input.X_BinSensor, input.bin};
+// 1. Prepare, in one pass over the input: units, NaN removal, bin frame, the cloud-vs-cell
+// evidence and a leading crop box (the rest of the filter chain then sees only the crop). Returns
+// the working cloud and the index of the first filter still to apply.
+std::pair<WorkingCloud, std::size_t> PrepareStage(const ModelingInput& input, const ModelingParams& params,
+                                                  const StopToken* stop, ModelingResult& result) {
+  const Clock::time_point t0 = Clock::now();
   PrepareSpec spec;
   spec.bin = input.bin;
   spec.plausibility = params.plausibility;
@@ -244,27 +232,40 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   if (first_filter == 1) result.counts.push_back({FilterName(params.filters.front()), work.cloud.size()});
   result.timings.push_back({"prepare", SecondsSince(t0)});
   ThrowIfStopped(stop, "prepare");
+  return {std::move(work), first_filter};
+}
 
-  // 2. The rest of the filters, with normals estimated when first needed (or after the last filter).
+// Normals of the working cloud (searched in the raw cloud or the working cloud itself); points
+// without a finite normal or curvature are dropped.
+void EstimateWorkingNormals(const ModelingInput& input, const ModelingParams& params, const StopToken* stop,
+                            const ModelingResult& result, WorkingCloud& work) {
   const Eigen::Vector3f viewpoint_Bin = input.X_BinSensor.translation().cast<float>();
+  const bool raw_surface = params.normals.search_surface == SearchSurface::kRaw;
+  const Points& surface = raw_surface ? result.raw_Bin : work.cloud.points;
+  OrientedPoints oriented =
+      EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop, params.threads);
+  std::vector<std::uint32_t> valid;
+  valid.reserve(oriented.size());
+  for (std::uint32_t i = 0; i < oriented.size(); ++i) {
+    if (oriented.normals[i].allFinite() && std::isfinite(oriented.curvature[i])) valid.push_back(i);
+  }
+  work.cloud = std::move(oriented);  // same points, same order: source_index still holds
+  work.has_normals = true;
+  if (valid.size() != work.cloud.size()) work.Keep(valid);
+}
+
+// 2. The rest of the filters, with normals estimated when first needed (or after the last filter);
+// the filtered cloud goes into the result.
+void FilterStage(const ModelingInput& input, const ModelingParams& params, const StopToken* stop,
+                 WorkingCloud work, std::size_t first_filter, ModelingResult& result) {
+  const FilterContext context{input.X_BinSensor, input.bin};
   double filter_seconds = 0.0, normal_seconds = 0.0;
   auto estimate_normals = [&]() {
     const Clock::time_point tn = Clock::now();
-    const Points& surface = raw_surface ? result.raw_Bin : work.cloud.points;
-    OrientedPoints oriented =
-        EstimateNormals(work.cloud.points, surface, params.normals, viewpoint_Bin, stop, params.threads);
-    std::vector<std::uint32_t> valid;
-    valid.reserve(oriented.size());
-    for (std::uint32_t i = 0; i < oriented.size(); ++i) {
-      if (oriented.normals[i].allFinite() && std::isfinite(oriented.curvature[i])) valid.push_back(i);
-    }
-    work.cloud = std::move(oriented);  // same points, same order: source_index still holds
-    work.has_normals = true;
-    if (valid.size() != work.cloud.size()) work.Keep(valid);
+    EstimateWorkingNormals(input, params, stop, result, work);
     result.counts.push_back({"normals", work.cloud.size()});
     normal_seconds += SecondsSince(tn);
   };
-
   for (std::size_t i = first_filter; i < params.filters.size(); ++i) {
     const FilterStep& step = params.filters[i];
     if (FilterNeedsNormals(step) && !work.has_normals) estimate_normals();
@@ -280,14 +281,17 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   result.timings.push_back({"normals", normal_seconds});
   result.filtered = std::move(work.cloud);
   result.filtered_source_index = std::move(work.source_index);
-  const OrientedPoints& cloud = result.filtered;
-  for (const auto& p : cloud.points)
+  for (const auto& p : result.filtered.points)
     result.max_height = std::max(result.max_height, static_cast<double>(p.z()));
   ThrowIfStopped(stop, "filter");
+}
 
-  // 3. Region-growing segmentation.
-  t0 = Clock::now();
-  const std::vector<Segment> segments = SegmentRegions(cloud, params.segmentation, stop, params.threads);
+// 3. Region-growing segmentation of the filtered cloud.
+std::vector<Segment> SegmentationStage(const ModelingParams& params, const StopToken* stop,
+                                       ModelingResult& result) {
+  const Clock::time_point t0 = Clock::now();
+  const OrientedPoints& cloud = result.filtered;
+  std::vector<Segment> segments = SegmentRegions(cloud, params.segmentation, stop, params.threads);
   result.segment_count = static_cast<std::uint32_t>(segments.size());
   result.segment_of_point.assign(cloud.size(), -1);
   std::uint64_t segmented = 0;
@@ -297,56 +301,91 @@ ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& para
   }
   result.counts.push_back({"segmented", segmented});
   result.timings.push_back({"segmentation", SecondsSince(t0)});
+  return segments;
+}
 
-  // 4. Cylinders per segment, in parallel; per-segment seeds make the result thread-count free.
-  t0 = Clock::now();
-  std::vector<std::vector<FittedCylinder>> per_segment(segments.size());
+// The fitted cylinders of all segments, in segment order, each with its inliers.
+struct FittedCylinders {
+  std::vector<std::vector<FittedCylinder>> per_segment;
+  std::vector<Cylinder> cylinders;
+  std::vector<const std::vector<std::uint32_t>*> inliers_of;  // into per_segment
+};
+
+// 4. Cylinders per segment, in parallel; per-segment seeds make the result thread-count free.
+void CylinderStage(const ModelingInput& input, const ModelingParams& params, const StopToken* stop,
+                   const std::vector<Segment>& segments, ModelingResult& result, FittedCylinders& out) {
+  const Clock::time_point t0 = Clock::now();
+  const OrientedPoints& cloud = result.filtered;
+  out.per_segment.assign(segments.size(), {});
   std::exception_ptr failure;
   const int n_segments = static_cast<int>(segments.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ResolveThreads(params.threads))
   for (int s = 0; s < n_segments; ++s) {
     try {
-      per_segment[s] = FitCylinders(cloud, segments[s], static_cast<std::uint32_t>(s), params.cylinders,
-                                    MixSeed(input.seed, 1000 + static_cast<std::uint64_t>(s)), stop);
+      out.per_segment[s] = FitCylinders(cloud, segments[s], static_cast<std::uint32_t>(s), params.cylinders,
+                                        MixSeed(input.seed, 1000 + static_cast<std::uint64_t>(s)), stop);
     } catch (...) {
 #pragma omp critical
       if (!failure) failure = std::current_exception();
     }
   }
   if (failure) std::rethrow_exception(failure);
-  std::vector<Cylinder> cylinders;
-  std::vector<const std::vector<std::uint32_t>*> inliers_of;
   std::uint64_t fitted = 0;
-  for (const auto& fits : per_segment) {
+  for (const auto& fits : out.per_segment) {
     for (const FittedCylinder& f : fits) {
-      cylinders.push_back(f.cylinder);
-      inliers_of.push_back(&f.inliers);
+      out.cylinders.push_back(f.cylinder);
+      out.inliers_of.push_back(&f.inliers);
       fitted += f.inliers.size();
     }
   }
-  result.cylinder_count = static_cast<std::uint32_t>(cylinders.size());
-  if (auto warning = TubeRadiusWarning(input.tube_radius, cylinders)) result.warnings.push_back(*warning);
+  result.cylinder_count = static_cast<std::uint32_t>(out.cylinders.size());
+  if (auto warning = TubeRadiusWarning(input.tube_radius, out.cylinders)) result.warnings.push_back(*warning);
   result.counts.push_back({"cylinder_inliers", fitted});
   result.timings.push_back({"cylinders", SecondsSince(t0)});
   ThrowIfStopped(stop, "cylinders");
+}
 
-  // 5. Tube joining, with the visibility range image of the filtered cloud; 6. junctions.
-  t0 = Clock::now();
+// 5. Tube joining, with the visibility range image of the filtered cloud; 6. junctions.
+void JoiningStage(const ModelingInput& input, const ModelingParams& params, const StopToken* stop,
+                  const FittedCylinders& fitted, ModelingResult& result) {
+  const Clock::time_point t0 = Clock::now();
+  const OrientedPoints& cloud = result.filtered;
   std::optional<RangeImage> visibility;
   if (params.joining.visibility_check && !cloud.points.empty()) {
     visibility.emplace(cloud.points, input.X_BinSensor, params.joining.visibility_pixel_angle);
   }
-  JoinedTubes joined = JoinModeledTubes(input, params, cylinders, cloud.points, inliers_of,
+  JoinedTubes joined = JoinModeledTubes(input, params, fitted.cylinders, cloud.points, fitted.inliers_of,
                                         visibility ? &*visibility : nullptr, stop);
   result.tubes = std::move(joined.tubes);
   if (joined.scan_length)
     result.warnings.push_back(TubeLengthWarning(input, params, *joined.scan_length, joined.trees));
-  result.tube_of_point = TubeOfPoint(result.tubes, cylinders, inliers_of, cloud.size());
+  result.tube_of_point = TubeOfPoint(result.tubes, fitted.cylinders, fitted.inliers_of, cloud.size());
   result.timings.push_back({"joining", SecondsSince(t0)});
+}
 
+}  // namespace
+
+ModelingResult ModelTubes(const ModelingInput& input, const ModelingParams& params, const StopToken* stop) {
+  if (input.points_Sensor != nullptr && !input.xyz_Sensor.bytes.empty()) {
+    throw std::invalid_argument("ModelingInput: both points_Sensor and xyz_Sensor are set");
+  }
+  if (input.xyz_Sensor.bytes.size() % 12 != 0) {
+    throw InvalidArgument("cloud: " + std::to_string(input.xyz_Sensor.bytes.size()) +
+                          " bytes is not a multiple of 12 (packed float32 x, y, z per point)");
+  }
+  params.Validate();
+  RequireRadiusWithinFit(input.tube_radius, params.cylinders);
+  const Clock::time_point t_start = Clock::now();
+  ModelingResult result;
+  auto [work, first_filter] = PrepareStage(input, params, stop, result);
+  FilterStage(input, params, stop, std::move(work), first_filter, result);
+  const std::vector<Segment> segments = SegmentationStage(params, stop, result);
+  FittedCylinders fitted;
+  CylinderStage(input, params, stop, segments, result, fitted);
+  JoiningStage(input, params, stop, fitted, result);
   result.total_seconds = SecondsSince(t_start);
   spdlog::debug("modeled {} tubes from {} points ({} filtered, {} segments, {} cylinders) in {:.3f} s",
-                result.tubes.size(), result.input_points, cloud.size(), result.segment_count,
+                result.tubes.size(), result.input_points, result.filtered.size(), result.segment_count,
                 result.cylinder_count, result.total_seconds);
   return result;
 }

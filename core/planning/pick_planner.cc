@@ -345,6 +345,60 @@ RawRegion RawRegionForPlanning(const PlanningParams& params, const BinConfig& bi
   return region;
 }
 
+namespace {
+
+// 1. Classification: each tube's class (too short, occlusion) and, for the free ones, the tubes
+// lying on them (their plans are not sure). Returns whether every tube is too short and planning
+// takes them anyway as a last resort (classification.short_tubes_last_resort).
+bool ClassificationStage(const ModelingResult& modeling, const CellConfig& cell, const PlanningParams& params,
+                         PickPlanResult* result, StageTimer* timer) {
+  const Clock::time_point t0 = Clock::now();
+  ClassificationResult classified = ClassifyTubes(modeling.tubes, cell.tube.length, params.classification);
+  result->tubes = std::move(classified.tubes);
+  result->classes = std::move(classified.classes);
+  result->bin_empty = IsBinEmpty(modeling, params);
+  PlanningCounts& counts = result->counts;
+  counts.tubes = static_cast<std::uint32_t>(result->tubes.size());
+  for (const TubeClass& cls : result->classes) {
+    if (cls.too_short) {
+      ++counts.too_short;
+    } else if (cls.occlusion == Occlusion::kNone) {
+      ++counts.non_occluded;
+    } else if (cls.occlusion == Occlusion::kWeak) {
+      ++counts.weakly_occluded;
+    } else {
+      ++counts.strongly_occluded;
+    }
+  }
+  const bool short_tubes =
+      counts.tubes > 0 && counts.too_short == counts.tubes && params.classification.short_tubes_last_resort;
+  for (std::size_t t = 0; t < result->tubes.size(); ++t) {
+    TubeClass& cls = result->classes[t];
+    if ((cls.too_short && !short_tubes) || cls.occlusion != Occlusion::kNone) continue;
+    cls.lying_on = TubesLyingOn(result->tubes, t, params.certainty);
+    if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
+  }
+  timer->Add("classification", t0);
+  return short_tubes;
+}
+
+// The plans ranked (the certainty rule), cut to max_plans; the best plan's occlusion class.
+void RankingStage(const PlanningParams& params, PickPlanResult* result, StageTimer* timer) {
+  const Clock::time_point t0 = Clock::now();
+  RankPlans(&result->plans, params.certainty);
+  if (params.max_plans > 0 && result->plans.size() > params.max_plans) result->plans.resize(params.max_plans);
+  if (!result->plans.empty()) {
+    for (std::size_t t = 0; t < result->tubes.size(); ++t) {
+      if (result->tubes[t].id == result->plans.front().tube_id)
+        result->planned_class = result->classes[t].occlusion;
+    }
+  }
+  timer->Add("ranking", t0);
+  result->counts.plans = static_cast<std::uint32_t>(result->plans.size());
+}
+
+}  // namespace
+
 PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, const PlanningParams& params,
                         TrajectoryEvaluator* evaluator, std::uint64_t seed, const StopToken* stop) {
   const Clock::time_point start = Clock::now();
@@ -366,43 +420,15 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
   StageTimer timer(&result.timings);
   ThrowIfStopped(stop, "planning");
 
-  // 1. Classification.
-  Clock::time_point t0 = Clock::now();
-  ClassificationResult classified = ClassifyTubes(modeling.tubes, cell.tube.length, params.classification);
-  result.tubes = std::move(classified.tubes);
-  result.classes = std::move(classified.classes);
-  result.bin_empty = IsBinEmpty(modeling, params);
-  PlanningCounts& counts = result.counts;
-  counts.tubes = static_cast<std::uint32_t>(result.tubes.size());
-  for (const TubeClass& cls : result.classes) {
-    if (cls.too_short) {
-      ++counts.too_short;
-    } else if (cls.occlusion == Occlusion::kNone) {
-      ++counts.non_occluded;
-    } else if (cls.occlusion == Occlusion::kWeak) {
-      ++counts.weakly_occluded;
-    } else {
-      ++counts.strongly_occluded;
-    }
-  }
-  // Which free tubes another tube lies on (their plans are not sure): part of classification.
-  const bool short_tubes =
-      counts.tubes > 0 && counts.too_short == counts.tubes && params.classification.short_tubes_last_resort;
-  for (std::size_t t = 0; t < result.tubes.size(); ++t) {
-    TubeClass& cls = result.classes[t];
-    if ((cls.too_short && !short_tubes) || cls.occlusion != Occlusion::kNone) continue;
-    cls.lying_on = TubesLyingOn(result.tubes, t, params.certainty);
-    if (!cls.lying_on.empty()) ++counts.non_occluded_lain_on;
-  }
-  timer.Add("classification", t0);
-  if (counts.too_short == counts.tubes && !short_tubes) {
+  const bool short_tubes = ClassificationStage(modeling, cell, params, &result, &timer);
+  if (result.counts.too_short == result.counts.tubes && !short_tubes) {
     result.total_seconds = SecondsSince(start);
     return result;
   }
 
   PlanningContext ctx(modeling, cell, params, evaluator, seed, stop);
   ctx.short_tubes = short_tubes;
-  counts.short_tubes_planned = short_tubes;
+  result.counts.short_tubes_planned = short_tubes;
   ctx.max_z = MaxHeight(modeling, result.tubes);
   ctx.zone = MakeSafetyZone(cell.bin, params.trajectories.safety_margin);
   ctx.tube_grasps.resize(result.tubes.size());
@@ -418,17 +444,7 @@ PickPlanResult PlanPick(const ModelingResult& modeling, const CellConfig& cell, 
     if (std::any_of(result.plans.begin(), result.plans.end(), safe)) break;
   }
 
-  t0 = Clock::now();
-  RankPlans(&result.plans, params.certainty);
-  if (params.max_plans > 0 && result.plans.size() > params.max_plans) result.plans.resize(params.max_plans);
-  if (!result.plans.empty()) {
-    for (std::size_t t = 0; t < result.tubes.size(); ++t) {
-      if (result.tubes[t].id == result.plans.front().tube_id)
-        result.planned_class = result.classes[t].occlusion;
-    }
-  }
-  timer.Add("ranking", t0);
-  counts.plans = static_cast<std::uint32_t>(result.plans.size());
+  RankingStage(params, &result, &timer);
   result.total_seconds = SecondsSince(start);
   return result;
 }

@@ -120,9 +120,28 @@ TEST(CellFrameCheckTest, PosesOutsideTheBinAreNamedWithTheBoundAndTheLikelyCause
                    "likely configured with another bin (cell bin.inner_size) or sensor pose"),
       std::string::npos)
       << problem;
-  input.X_BinTcpGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.26));  // above the wall top
-  input.X_BinTcpPreGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.36));
-  EXPECT_NE(Problem(cell, input).find("z > 0.220 m (above the wall top)"), std::string::npos);
+  // Above the wall top: misconfigured, or a tube leaning on a wall (the operator's matter).
+  input.X_BinTcpGrasp = DownPose(Eigen::Vector3d(-0.333, -0.207, 0.317));
+  input.X_BinTcpPreGrasp = DownPose(Eigen::Vector3d(-0.333, -0.207, 0.417));
+  problem = Problem(cell, input);
+  EXPECT_NE(
+      problem.find("z > 0.220 m, 0.117 m above the wall top (cell_check.grasp_above_walls 0.000 m)); the "
+                   "planner is likely configured with another bin"),
+      std::string::npos)
+      << problem;
+  EXPECT_NE(problem.find("or a tube lies that high: leaning on a wall, partly outside the bin"),
+            std::string::npos)
+      << problem;
+  // A cell whose heap rises above the walls allows it, up to the bound and the margin.
+  CellFrameCheckParams heap;
+  heap.grasp_above_walls = 0.3;
+  EXPECT_EQ(Problem(cell, input, heap), "");
+  input.X_BinTcpGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.53));
+  input.X_BinTcpPreGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.63));
+  problem = Problem(cell, input, heap);
+  EXPECT_NE(problem.find("z > 0.520 m, 0.330 m above the wall top (cell_check.grasp_above_walls 0.300 m)"),
+            std::string::npos)
+      << problem;
   input.X_BinTcpGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.03));
   input.X_BinTcpPreGrasp = DownPose(Eigen::Vector3d(0.0, 0.0, 0.13));
   input.waypoints_Bin = {Eigen::Vector3d::Zero(), Eigen::Vector3d(0.2, 0, 0.02),
@@ -144,6 +163,9 @@ TEST(CellFrameCheckTest, PosesOutsideTheBinAreNamedWithTheBoundAndTheLikelyCause
 TEST(CellFrameCheckTest, BadParamsNameTheField) {
   CellFrameCheckParams params;
   params.bin_margin = -0.1;
+  EXPECT_THROW(params.Validate(), InvalidArgument);
+  params = {};
+  params.grasp_above_walls = -0.3;
   EXPECT_THROW(params.Validate(), InvalidArgument);
   params = {};
   params.place_rotation_tolerance = 30.0;
