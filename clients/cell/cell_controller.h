@@ -150,7 +150,8 @@ struct PlannedMotion {
   std::string step;
   /// Robot motions: the TCP pose at the end. Gripper commands: where the TCP is meanwhile.
   Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
-  /// kTransit: the poses moved to before X_BinTcp (up to transit height, across), in order.
+  /// kTransit: the poses moved to before X_BinTcp (up to transit height, across), in order;
+  /// kMoveTo: the stops on the way (the place descent's, where it reads the F/T).
   std::vector<Eigen::Isometry3d> via;
   /// kMoveThrough: the TCP translations from the pose before it, bin axes (the first is (0, 0, 0)).
   std::vector<Eigen::Vector3d> waypoints_Bin;
@@ -406,6 +407,10 @@ class CellController {
                                              const Eigen::Isometry3d& X_BinTcpHold, Attempt& attempt);
   void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
              Attempt& attempt);
+  /// From the current pose straight down to the place pose in steps of place_step, reading the F/T
+  /// after each; stops where the tube no longer weighs a tube (it rests on the place surface).
+  void DescendOntoPlace(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
+                        Attempt& attempt);
   /// The gripper still reports the object (Robotiq gOBJ 2); throws TubeLost naming `where` if not.
   void CheckStillHolding(const char* where, Attempt& attempt);
   /// The load at the pose above the place pose still weighs a tube; throws TubeLost if not.

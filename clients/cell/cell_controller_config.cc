@@ -113,6 +113,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("release_height", p.release_height, "m above the grasp to put back several tubes");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
   v("place_recheck_height", p.place_recheck_height, "m higher again when the load there is light");
+  v("place_step", p.place_step,
+    "m: down to the place pose in steps, opening where the tube rests; 0 = one move");
   v("safe_release_height", p.safe_release_height,
     "m above the bin floor: a safe stop holding a tube opens there, over the bin's middle");
   v.OptionalPose("home_pose_in_bin", p.X_BinHome,

@@ -55,6 +55,7 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(release_height, "release_height");
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
   RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
+  RequireNonNegativeValue(place_step, "place_step");
   RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
     throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");
@@ -109,6 +110,21 @@ void CellControllerParams::Validate() const {
 
 double TransitHeight(const CellControllerParams& params, const CellConfig& cell) {
   return cell.bin.inner_size.z() + params.transit_clearance;
+}
+
+std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,
+                                                 const Eigen::Isometry3d& X_BinTcpFrom,
+                                                 const Eigen::Isometry3d& X_BinTcpPlace) {
+  const double height = X_BinTcpFrom.translation().z() - X_BinTcpPlace.translation().z();
+  if (!(params.place_step > 0.0) || !(height > params.place_step)) return {};
+  const int steps = static_cast<int>(std::ceil(height / params.place_step - 1e-9));
+  std::vector<Eigen::Isometry3d> out;
+  for (int k = 1; k < steps; ++k) {
+    Eigen::Isometry3d X_BinTcpStep = X_BinTcpPlace;
+    X_BinTcpStep.translation().z() += height * (1.0 - static_cast<double>(k) / steps);
+    out.push_back(X_BinTcpStep);
+  }
+  return out;
 }
 
 Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell) {

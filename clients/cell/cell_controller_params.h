@@ -66,6 +66,13 @@ struct CellControllerParams {
   /// hangs). The TCP then rises this much more and reads again; only a load still missing there is
   /// a lost tube. 0 = no second reading. Metres.
   double place_recheck_height = 0.20;
+  /// From above the place pose down to it, the TCP goes in steps of at most this, reading the
+  /// F/T after each; where the held tube no longer weighs a tube (it rests on the place surface: a
+  /// part the model missed hangs lower than the model), the descent stops and the gripper opens
+  /// there instead of pushing the tube down to the planned pose. 0 = one move. Metres. In the
+  /// simulated 20-tree bins (docs/ACCURACY.md) the planned descent pressed held trees on the
+  /// place zone with 50-200 N.
+  double place_step = 0.02;
   /// Where the robot waits while the bin is scanned (out of the scanner's view). Absent: above the
   /// cell's placement frame at transit height, TCP pointing down.
   std::optional<Eigen::Isometry3d> X_BinHome;
@@ -160,5 +167,10 @@ struct CellControllerParams {
 Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell);
 /// Height of transit moves in the bin frame: wall top + transit_clearance, metres.
 double TransitHeight(const CellControllerParams& params, const CellConfig& cell);
+/// The poses between `X_BinTcpFrom` (straight above the place pose) and `X_BinTcpPlace` where the
+/// place descent stops to read the F/T (place_step), top down, neither end included.
+std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,
+                                                 const Eigen::Isometry3d& X_BinTcpFrom,
+                                                 const Eigen::Isometry3d& X_BinTcpPlace);
 
 }  // namespace tubepick::cell

@@ -95,8 +95,9 @@ std::vector<PlannedMotion> CellController::PlannedMotions(const PlanPoses& poses
   Eigen::Isometry3d X_BinTcpAbovePlace = poses.X_BinTcpPlace;
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
   transit(CellState::kPlace, "transit above the place pose", X_BinTcpLift, X_BinTcpAbovePlace);
-  robot(MotionKind::kMoveTo, CellState::kPlace, "down to the place pose", poses.X_BinTcpPlace,
-        params_.approach_speed);
+  robot(MotionKind::kMoveTo, CellState::kPlace, "down to the place pose (opens where the tube rests)",
+        poses.X_BinTcpPlace, params_.approach_speed)
+      .via = PlaceDescentSteps(params_, X_BinTcpAbovePlace, poses.X_BinTcpPlace);
   gripper(MotionKind::kGripperOpen, CellState::kPlace, "open: the tube is placed", poses.X_BinTcpPlace, 0.0,
           std::nullopt, std::nullopt);
   robot(MotionKind::kMoveTo, CellState::kPlace, "back up above the place pose", X_BinTcpAbovePlace,

@@ -1101,12 +1101,109 @@ TEST_F(CellControllerTest, PlannerRejectingTheAnalysisIsStillAFault) {
   EXPECT_EQ(result.safe_stop->action, "released_in_bin");  // holding: back into the bin
 }
 
+// ---------------------------------------------------------------- the place descent
+
+class PlaceDescentTest : public CellControllerTest {
+ protected:
+  void SetUp() override {
+    CellControllerTest::SetUp();
+    planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+    planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  }
+  /// Heights (bin z) the robot stopped at straight above the place pose, in order.
+  std::vector<double> StopsAboveThePlace() const {
+    std::vector<double> z;
+    const Eigen::Vector3d p = testing::PlacePose().translation();
+    for (const auto& m : robot.moves) {
+      const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+      if (!m.through && (q.head<2>() - p.head<2>()).norm() < kTol && q.z() < p.z() + 0.1 - kTol)
+        z.push_back(q.z());
+    }
+    return z;
+  }
+};
+
+TEST_F(PlaceDescentTest, ATubeThatTouchesDownEarlyIsReleasedWhereItRestsNotPushedDown) {
+  // Reference, lift, above the place, the first step (still one tube), the second (it rests: no load).
+  ft.readings = {Reading(0.10), Reading(0.64), Reading(0.64), Reading(0.64), Reading(0.10)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  // Place pose at z 0.12, above it 0.22: steps of 2 cm, stopped at the second, 6 cm above the pose.
+  const std::vector<double> stops = StopsAboveThePlace();
+  ASSERT_EQ(stops.size(), 2u);
+  EXPECT_NEAR(stops[0], 0.20, kTol);
+  EXPECT_NEAR(stops[1], 0.18, kTol);
+  ASSERT_GE(gripper.opened_at.size(), 2u);
+  EXPECT_NEAR(gripper.opened_at[1].z(), 0.18, kTol);
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["placed"], true);
+  EXPECT_NEAR(a["place_touchdown"].get<double>(), 0.06, kTol);
+}
+
+TEST_F(PlaceDescentTest, ATubeThatHangsAsModeledGoesDownToThePlacePoseInSteps) {
+  ft.readings = {Reading(0.10), Reading(0.64)};  // one tube from the lift on, until the gripper opens
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  const std::vector<double> stops = StopsAboveThePlace();
+  ASSERT_EQ(stops.size(), 5u);
+  for (std::size_t i = 0; i < stops.size(); ++i) EXPECT_NEAR(stops[i], 0.20 - 0.02 * i, kTol) << i;
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(testing::PlacePose().translation(), kTol));
+  EXPECT_FALSE(Records("attempt").at(0).contains("place_touchdown"));
+}
+
+TEST_F(PlaceDescentTest, ATubeJammedOnThePlaceSurfaceIsReleasedWhereTheReadingsStartToDisagree) {
+  params.ft_samples = 3;
+  params.ft_unsettled_retries = 0;
+  // Reference, lift, above the place, the first step: one tube; the second step presses a rigid
+  // tree on the surface (readings drifting by 10-15 N): it is down.
+  ft.readings = {Reading(0.10), Reading(0.10), Reading(0.10),  Reading(0.64),  Reading(0.64),
+                 Reading(0.64), Reading(0.64), Reading(0.64),  Reading(0.64),  Reading(0.64),
+                 Reading(0.64), Reading(0.64), Reading(150.0), Reading(160.0), Reading(175.0)};
+  const CellRunResult result = Run();
+  EXPECT_FALSE(result.fault) << result.message;
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  ASSERT_GE(gripper.opened_at.size(), 2u);
+  EXPECT_NEAR(gripper.opened_at[1].z(), 0.18, kTol);
+  const json a = Records("attempt").at(0);
+  EXPECT_NEAR(a["place_touchdown"].get<double>(), 0.06, kTol);
+  EXPECT_THAT(a["wrench"]["place_descent_unsettled"].get<std::string>(),
+              ::testing::HasSubstr("pressing on something"));
+}
+
+TEST_F(PlaceDescentTest, ATubePressingOnThePlaceZoneIsReadAgainHigherUpThenLoweredInSteps) {
+  params.ft_samples = 3;
+  params.ft_unsettled_retries = 0;
+  // Reference, lift; above the place the held tree presses on the zone (readings drifting by
+  // 10-15 N); 0.2 m higher it hangs free, and it stays one tube down to the place pose.
+  ft.readings = {Reading(0.10),  Reading(0.10),  Reading(0.10),  Reading(0.64), Reading(0.64), Reading(0.64),
+                 Reading(190.0), Reading(200.0), Reading(215.0), Reading(0.64), Reading(0.64), Reading(0.64)};
+  const CellRunResult result = Run();
+  EXPECT_FALSE(result.fault) << result.message;
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  const json a = Records("attempt").at(0);
+  EXPECT_THAT(a["wrench"]["before_place_unsettled"].get<std::string>(),
+              ::testing::HasSubstr("pressing on something"));
+  // Up to 0.42 m (0.2 above the place approach), then down in 2 cm steps to the place pose.
+  std::vector<double> z;  // the TCP's heights over the place pose, in order
+  for (const auto& m : robot.moves) {
+    const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+    if ((q.head<2>() - testing::PlacePose().translation().head<2>()).norm() < kTol) z.push_back(q.z());
+  }
+  const auto up = std::find_if(z.begin(), z.end(), [](double h) { return std::abs(h - 0.42) < kTol; });
+  ASSERT_NE(up, z.end());
+  const auto down = std::find_if(up, z.end(), [](double h) { return std::abs(h - 0.12) < kTol; });
+  ASSERT_NE(down, z.end());
+  EXPECT_EQ(down - up, 15);  // 0.40, 0.38, ..., 0.14, then the place pose
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(testing::PlacePose().translation(), kTol));
+}
+
 // ---------------------------------------------------------------- faults during place
 
 class PlaceFaultTest : public CellControllerTest {
  protected:
   void SetUp() override {
     CellControllerTest::SetUp();
+    params.place_step = 0.0;  // one move down to the place pose (the stepped descent: PlaceDescentTest)
     planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
     ft.readings = {Reading(0.10), Reading(0.64), Reading(0.64)};  // reference, lift, above the place
     planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
