@@ -3,13 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <csignal>
 #include <functional>
 #include <string>
+#include <thread>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
+#include "clients/cli/cell/planner_outage.h"
 #include "clients/cli/cell/sim_round.h"
 #include "devices/sim/sim_cell.h"
 #include "physics/tube_geometry.h"
@@ -207,6 +210,39 @@ TEST_F(CellEndToEndTest, ServerGoneWhileATubeIsHeldIsAnalysedLocallyThenTheRound
   EXPECT_NE(r.run.message.find("SAFE STOP: planner server_unavailable during plan"), std::string::npos)
       << r.run.message;
 }
+
+#ifdef TUBEPICK_SERVER
+TEST(PlannerProcessTest, APlannerKilledBetweenCallsIsGivenUpAfterTheUnavailableBudgetNotTheDeadline) {
+  // tubepick-server as a process: killed (SIGKILL, no goodbye on the connection) after one call,
+  // the client's channel still READY. The next PlanPick must end within the unavailable budget
+  // (here 2 s), not wait out its deadline (a run's plan_deadline is 180 s): a cell whose planner
+  // died stops within seconds and says why.
+  cli::RestartableServer server(TUBEPICK_SERVER, {"--metrics-address", "", "--log-level", "info"});
+  cell::GrpcPlannerClientOptions options;
+  options.unavailable_budget = std::chrono::seconds(2);
+  cell::GrpcPlannerClient planner(server.address(), options);
+  const v1::PlanPickRequest empty;  // no cloud: INVALID_ARGUMENT, at once
+  try {
+    planner.PlanPick(empty, std::chrono::seconds(10));
+    FAIL() << "an empty request was planned";
+  } catch (const cell::PlannerError& e) {
+    ASSERT_EQ(e.code(), grpc::StatusCode::INVALID_ARGUMENT) << e.what();
+  }
+  // As the campaign's outage does (RestartableServer::Kill): SIGTERM, so the server says goodbye
+  // on the connection, then SIGKILL; the call starts in between, on the channel still READY.
+  const pid_t pid = server.pid();
+  ::kill(pid, SIGTERM);
+  ::kill(pid, SIGKILL);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    planner.PlanPick(empty, std::chrono::seconds(60));
+    FAIL() << "planned without a planner";
+  } catch (const cell::PlannerError& e) {
+    EXPECT_EQ(e.code(), grpc::StatusCode::UNAVAILABLE) << e.what();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+#endif
 
 TEST_F(CellEndToEndTest, TubeThatSlipsInTransitFallsIntoTheBinOrThePlaceZoneAndIsRecordedAsLost) {
   cell::GrpcPlannerClient planner(address());

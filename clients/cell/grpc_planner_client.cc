@@ -159,7 +159,10 @@ struct GrpcPlannerClient::Impl {
           return LastTry<Response>(rpc, deadline, call, attempt, unavailable, budget_name, generation);
       }
       grpc::ClientContext context;
-      context.set_wait_for_ready(true);  // a connection lost just now is waited for, not failed
+      // Fail fast: a connection lost just now (a planner killed between calls, the channel still
+      // READY) gives UNAVAILABLE at once, which the loop retries within the budget; waiting for
+      // ready would wait out the call's deadline (minutes for a PlanPick) instead.
+      context.set_wait_for_ready(false);
       context.set_deadline(std::chrono::system_clock::now() + deadline);
       Response response;
       grpc::Status status;
