@@ -32,14 +32,13 @@ std::string MillimetresCause() {
          "in mm (sensor.unit, the request's cloud unit)?";
 }
 
-/// Why `p_Bin` (the TCP at `what`) is outside the bin, or "". With `above_walls` (≥ 0), it must
-/// also lie at most that far above the wall top (plus the margin); negative: no bound above.
+/// Why `p_Bin` (the TCP at `what`) is outside the bin, or "". With `above_walls`, it must also lie
+/// at most that far above the wall top (plus the margin); without, there is no bound above.
 std::string OutsideBin(const Eigen::Vector3d& p_Bin, const std::string& what, const CellConfig& cell,
-                       double margin, double above_walls) {
+                       double margin, std::optional<double> above_walls) {
   const Eigen::Vector3d& size = cell.bin.inner_size;
   const double x_max = 0.5 * size.x() + margin, y_max = 0.5 * size.y() + margin;
-  const double z_min = -margin, z_max = size.z() + above_walls + margin;
-  const bool below_wall_top = above_walls >= 0.0;
+  const double z_min = -margin, z_max = size.z() + above_walls.value_or(0.0) + margin;
   std::string bound;
   bool too_high = false;
   if (!p_Bin.allFinite())
@@ -50,9 +49,11 @@ std::string OutsideBin(const Eigen::Vector3d& p_Bin, const std::string& what, co
     bound = fmt::format("|y| > {:.3f} m", y_max);
   else if (p_Bin.z() < z_min)
     bound = fmt::format("z < {:.3f} m (below the floor)", z_min);
-  else if ((too_high = below_wall_top && p_Bin.z() > z_max))
+  else if (above_walls && p_Bin.z() > z_max) {
+    too_high = true;
     bound = fmt::format("z > {:.3f} m, {:.3f} m above the wall top (cell_check.grasp_above_walls {:.3f} m)",
-                        z_max, p_Bin.z() - size.z(), above_walls);
+                        z_max, p_Bin.z() - size.z(), *above_walls);
+  }
   if (bound.empty()) return "";
   std::string cause =
       LooksLikeMillimetres(p_Bin, cell)
@@ -206,10 +207,11 @@ std::optional<std::string> CellFrameProblem(const CellConfig& cell, const CellFr
   const Eigen::Vector3d p_Bin_grasp = plan.X_BinTcpGrasp.translation();
   std::string problem = OutsideBin(p_Bin_grasp, "grasp", cell, params.bin_margin, params.grasp_above_walls);
   if (problem.empty())
-    problem = OutsideBin(plan.X_BinTcpPreGrasp.translation(), "pre-grasp", cell, params.bin_margin, -1.0);
+    problem =
+        OutsideBin(plan.X_BinTcpPreGrasp.translation(), "pre-grasp", cell, params.bin_margin, std::nullopt);
   for (std::size_t i = 0; problem.empty() && i < plan.waypoints_Bin.size(); ++i)
     problem = OutsideBin(p_Bin_grasp + plan.waypoints_Bin[i], fmt::format("lift waypoint {}", i), cell,
-                         params.bin_margin, -1.0);
+                         params.bin_margin, std::nullopt);
   if (!problem.empty()) return problem;
   if (plan.X_BinTcpPlace) return PlaceProblem(cell, params, plan);
   return std::nullopt;
