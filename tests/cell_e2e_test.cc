@@ -6,7 +6,6 @@
 #include <csignal>
 #include <functional>
 #include <string>
-#include <thread>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
@@ -213,8 +212,8 @@ TEST_F(CellEndToEndTest, ServerGoneWhileATubeIsHeldIsAnalysedLocallyThenTheRound
 
 #ifdef TUBEPICK_SERVER
 TEST(PlannerProcessTest, APlannerKilledBetweenCallsIsGivenUpAfterTheUnavailableBudgetNotTheDeadline) {
-  // tubepick-server as a process: killed (SIGKILL, no goodbye on the connection) after one call,
-  // the client's channel still READY. The next PlanPick must end within the unavailable budget
+  // tubepick-server as a process, killed after one call (SIGTERM then SIGKILL at once, as the
+  // fault campaign's outage does). The next PlanPick must end within the unavailable budget
   // (here 2 s), not wait out its deadline (a run's plan_deadline is 180 s): a cell whose planner
   // died stops within seconds and says why.
   cli::RestartableServer server(TUBEPICK_SERVER, {"--metrics-address", "", "--log-level", "info"});

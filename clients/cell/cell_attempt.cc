@@ -310,20 +310,13 @@ void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
   TransitTo(X_BinTcpAbovePlace, &attempt, [&] { CheckStillHolding("place_transit", attempt); });
   v1::AnalyzeWrenchResponse check;
-  bool loaded = false;
-  try {
-    loaded = LoadBeforePlace(reference, "before_place", attempt, &check);
-  } catch (const CellFault& fault) {
-    // Readings that keep disagreeing above the place: the held tube pressing on the place surface
-    // (a part the model missed hangs lower than the model). Higher up it hangs free; a sensor that
-    // is at fault disagrees there too.
-    if (fault.device() != "ft_sensor" || fault.kind() != FaultKind::kDeviceFault ||
-        params_.place_recheck_height == 0.0)
-      throw;
-    attempt.record["wrench"]["before_place_unsettled"] = fault.error();
-    spdlog::warn("cell: round {}: above the place pose: {}; rising {:.2f} m to read again", round_,
-                 fault.error(), params_.place_recheck_height);
-  }
+  // Readings that keep disagreeing above the place: the held tube pressing on the place surface (a
+  // part the model missed hangs lower than the model). Higher up it hangs free; a sensor at fault
+  // disagrees there too. Without the recheck, they are the F/T fault they look like.
+  const bool loaded =
+      params_.place_recheck_height > 0.0
+          ? LoadBeforePlaceUnlessPressing(reference, "before_place", attempt, &check).value_or(false)
+          : LoadBeforePlace(reference, "before_place", attempt, &check);
   if (!loaded) {
     // Light (or pressing) while the fingers still hold something: resting on the place surface,
     // or lost.
@@ -356,17 +349,11 @@ void CellController::DescendOntoPlace(const Eigen::Isometry3d& X_BinTcpPlace,
                                       const devices::WrenchReading& reference, Attempt& attempt) {
   for (const Eigen::Isometry3d& X_BinTcpStep : PlaceDescentSteps(params_, CurrentPose(), X_BinTcpPlace)) {
     MoveTo(X_BinTcpStep, params_.approach_speed, &attempt);
-    bool resting = false;
-    try {
-      v1::AnalyzeWrenchResponse check;
-      resting = !LoadBeforePlace(reference, "place_descent", attempt, &check);
-    } catch (const CellFault& fault) {
-      // Readings that keep disagreeing one step lower than a steady one: the tube pressed on the
-      // place surface (a rigid tube jams between the pads and the surface). It is down: open.
-      if (fault.device() != "ft_sensor" || fault.kind() != FaultKind::kDeviceFault) throw;
-      attempt.record["wrench"]["place_descent_unsettled"] = fault.error();
-      resting = true;
-    }
+    // Readings that keep disagreeing one step lower than a steady one: a rigid tube jammed between
+    // the pads and the surface. It is down: open.
+    v1::AnalyzeWrenchResponse check;
+    const bool resting =
+        !LoadBeforePlaceUnlessPressing(reference, "place_descent", attempt, &check).value_or(false);
     if (resting) {
       const double above = X_BinTcpStep.translation().z() - X_BinTcpPlace.translation().z();
       attempt.record["place_touchdown"] = above;
@@ -397,6 +384,19 @@ bool CellController::LoadBeforePlace(const devices::WrenchReading& reference, co
   *check = LocalAnalyzeWrench(WrenchRequest(reference, above, CurrentPose()), params_.profile);
   attempt.record["wrench"][key] = WrenchJson(above);
   return check->outcome() != v1::HELD_OUTCOME_NONE;
+}
+
+std::optional<bool> CellController::LoadBeforePlaceUnlessPressing(const devices::WrenchReading& reference,
+                                                                  const char* key, Attempt& attempt,
+                                                                  v1::AnalyzeWrenchResponse* check) {
+  try {
+    return LoadBeforePlace(reference, key, attempt, check);
+  } catch (const CellFault& fault) {
+    if (fault.device() != "ft_sensor" || fault.kind() != FaultKind::kDeviceFault) throw;
+    attempt.record["wrench"][std::string(key) + "_unsettled"] = fault.error();
+    spdlog::warn("cell: round {}: over the place pose ({}): {}", round_, key, fault.error());
+    return std::nullopt;
+  }
 }
 
 void CellController::RecordLost(const TubeLost& lost, Attempt& attempt) {

@@ -418,6 +418,11 @@ class CellController {
   /// a tube.
   bool LoadBeforePlace(const devices::WrenchReading& reference, const char* key, Attempt& attempt,
                        v1::AnalyzeWrenchResponse* check);
+  /// LoadBeforePlace, except that a measurement whose readings keep disagreeing (the F/T's
+  /// device_fault: the held tube pressing on the place surface) is recorded under
+  /// record["wrench"][key + "_unsettled"] and gives nullopt.
+  std::optional<bool> LoadBeforePlaceUnlessPressing(const devices::WrenchReading& reference, const char* key,
+                                                    Attempt& attempt, v1::AnalyzeWrenchResponse* check);
   /// The tube is gone: record where and when, open (the fingers closed on nothing), home.
   void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);

@@ -19,9 +19,8 @@ struct CellFrameCheckParams {
   /// Check at all (false: plans are only checked against the robot's limits and the tool clearance).
   bool enabled = true;
   /// The grasp must lie inside the bin's interior (floor to wall top; see grasp_above_walls), the
-  /// pre-grasp pose and the
-  /// lift waypoints above the floor and over the bin's inner footprint, each grown by this margin,
-  /// metres.
+  /// pre-grasp pose and the lift waypoints above the floor and over the bin's inner footprint, each
+  /// grown by this margin, metres.
   double bin_margin = 0.02;
   /// The grasp may also lie up to this far above the wall top (plus bin_margin), over the bin's
   /// inner footprint, for a cell whose heap is meant to rise above the walls (the modeling's crop
