@@ -270,6 +270,10 @@ TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
             std::string::npos)
       << ParseError("ft_unsettled_retries: -1\n");
   EXPECT_NE(ParseError("ft_read_retries: two\n").find("ft_read_retries"), std::string::npos);
+  EXPECT_NE(ParseError("place_step: -0.02\n").find("place_step: must be a non-negative number, got -0.02"),
+            std::string::npos)
+      << ParseError("place_step: -0.02\n");
+  EXPECT_EQ(ParseCellControllerParams("place_step: 0.01\n").place_step, 0.01);
 }
 
 TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {
@@ -294,6 +298,13 @@ TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {
                 .find("cell_check.place_rotation_tolerance: must be in [0, pi] rad, got 20 (degrees?)"),
             std::string::npos)
       << ParseError("cell_check:\n  place_rotation_tolerance: 20\n");
+  EXPECT_NE(ParseError("cell_check:\n  grasp_above_walls: -0.3\n")
+                .find("cell_check.grasp_above_walls: must be a non-negative number, got -0.3"),
+            std::string::npos)
+      << ParseError("cell_check:\n  grasp_above_walls: -0.3\n");
+  EXPECT_EQ(
+      ParseCellControllerParams("cell_check:\n  grasp_above_walls: 0.25\n").cell_check.grasp_above_walls,
+      0.25);
   EXPECT_NE(ParseError("cell_check:\n  margin: 0.1\n").find("cell_check.margin"), std::string::npos);
   EXPECT_NE(ParseError("cell_check:\n  enabled: perhaps\n").find("cell_check.enabled"), std::string::npos);
 }
