@@ -89,6 +89,11 @@ Params ProfileParams(const std::string& name) {
     // those 33 double picks 23 freed against 19 with no tree outside the bin, and in six 20-tree
     // set-C cell rounds 6 of 9 resolutions freed one tree against 6 of 11 (docs/ACCURACY.md).
     p.wrench.variant = ResolutionVariant::kTorqueAxisThenPerpendicular;
+    // Algorithm 3's F_tol (0.25 N) is 0.46 of a 55 g PVC tube's weight and 0.31 of a set-C tree's:
+    // a tree with a third of another hanging from it read as one (1.30 tubes) and both were carried
+    // out. Single lifts in the simulated cell weighed 0.91-1.07 tubes (2187 lifts), several 1.38 and
+    // more (docs/ACCURACY.md): the band is at most a fifth of a tube's weight either side.
+    p.wrench.force_tolerance_share = 0.2;
   } else if (name == "thesis") {
     p.modeling = ThesisModelingProfile();
   } else {

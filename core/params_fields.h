@@ -304,6 +304,7 @@ template <typename Visit>
 void DescribeFields(Visit& v, WrenchParams& p) {
   v("gravity", p.gravity);
   v("force_tolerance", p.force_tolerance);
+  v("force_tolerance_share", p.force_tolerance_share);
   v("max_tilt", p.max_tilt);
   v("rotation_angle", p.rotation_angle);
   v("min_torque", p.min_torque);

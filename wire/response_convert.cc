@@ -119,6 +119,7 @@ v1::AnalyzeWrenchResponse ToAnalyzeWrenchResponse(const HeldCount& count,
   response.set_expected_force(count.expected_force);
   response.set_held_weight(count.held_weight);
   response.set_tube_ratio(count.tube_ratio);
+  response.set_force_tolerance(count.force_tolerance);
   if (count.outcome == HeldOutcome::kMultiple) {
     *response.mutable_delta_torque_tcp() = ToProto(delta_torque_Tcp);
     if (resolution) {

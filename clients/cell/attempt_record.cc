@@ -64,6 +64,7 @@ nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis) {
           {"tube_ratio", analysis.tube_ratio()},
           {"held_weight", analysis.held_weight()},
           {"tube_weight", analysis.tube_weight()},
+          {"force_tolerance", analysis.force_tolerance()},
           {"motions", analysis.resolution_motions_size()}};
 }
 

@@ -47,7 +47,8 @@ nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& 
 nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
                          double opening_width);
 
-/// {"outcome", "estimated_count", "tube_ratio", "held_weight", "tube_weight", "motions"}.
+/// {"outcome", "estimated_count", "tube_ratio", "held_weight", "tube_weight", "force_tolerance",
+/// "motions"}.
 nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis);
 
 /// An attempt (or a scan without a plan) in a few words from its record: the lift's outcome and tubes

@@ -32,6 +32,7 @@ HeldCount CountHeldTubes(double fz_ref, double fz, double tube_mass, const Wrenc
   // Algorithm 3, lines 1-2.
   result.tube_weight = tube_mass * params.gravity;
   result.expected_force = fz_ref - result.tube_weight;
+  result.force_tolerance = EffectiveForceTolerance(params, result.tube_weight);
   if (!(params.force_tolerance < result.tube_weight)) {
     std::ostringstream s;
     s << "wrench.force_tolerance: " << params.force_tolerance
@@ -41,9 +42,9 @@ HeldCount CountHeldTubes(double fz_ref, double fz, double tube_mass, const Wrenc
     throw InvalidArgument(s.str());
   }
   // Lines 3-8: strict comparisons, the band edges are kSingle.
-  if (fz < result.expected_force - params.force_tolerance) {
+  if (fz < result.expected_force - result.force_tolerance) {
     result.outcome = HeldOutcome::kMultiple;
-  } else if (fz > result.expected_force + params.force_tolerance) {
+  } else if (fz > result.expected_force + result.force_tolerance) {
     result.outcome = HeldOutcome::kNone;
   } else {
     result.outcome = HeldOutcome::kSingle;

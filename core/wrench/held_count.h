@@ -20,6 +20,8 @@ struct HeldCount {
   HeldOutcome outcome = HeldOutcome::kNone;
   /// Weight of one tube, mass · gravity.
   double tube_weight = 0.0;
+  /// Half-width of the single band used, N (EffectiveForceTolerance).
+  double force_tolerance = 0.0;
   /// Expected upward force with exactly one tube held: F_z_ref − tube_weight.
   double expected_force = 0.0;
   /// Weight gained since the reference, F_z_ref − F_z (negative when the gripper got lighter).
@@ -31,9 +33,10 @@ struct HeldCount {
   std::uint32_t estimated_count = 0;
 };
 
-/// Algorithm 3 (§5.2.5), exactly: expected = F_z_ref − mass·g; F_z < expected − F_tol ⇒ kMultiple;
+/// Algorithm 3 (§5.2.5): expected = F_z_ref − mass·g; F_z < expected − F_tol ⇒ kMultiple;
 /// F_z > expected + F_tol ⇒ kNone; otherwise kSingle. Both comparisons are strict, so F_z equal to
-/// expected ± F_tol is kSingle.
+/// expected ± F_tol is kSingle. F_tol is EffectiveForceTolerance: the thesis' exactly when
+/// params.force_tolerance_share is 0.
 /// @param fz_ref upward force with the gripper empty (before picking), N.
 /// @param fz upward force after grasping and lifting, N.
 /// @param tube_mass mass of one tube (cell `tube.mass`), kg.

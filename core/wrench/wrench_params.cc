@@ -1,5 +1,6 @@
 #include "core/wrench/wrench_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -36,6 +37,13 @@ void RequirePerpendicular(const Eigen::Vector3d& v, const std::string& key, cons
 void WrenchParams::Validate() const {
   RequirePositive(gravity, "wrench.gravity");
   RequireNonNegative(force_tolerance, "wrench.force_tolerance");
+  RequireFinite(force_tolerance_share, "wrench.force_tolerance_share");
+  if (!(force_tolerance_share >= 0.0 && force_tolerance_share < 1.0)) {
+    std::ostringstream s;
+    s << "wrench.force_tolerance_share: " << force_tolerance_share
+      << " is out of range [0, 1) (a share of one tube's weight; 0 = wrench.force_tolerance alone)";
+    throw InvalidArgument(s.str());
+  }
   RequireNonZeroVector(up_Tcp, "wrench.up_Tcp");
   RequireInRange(max_tilt, 0.0, M_PI / 2.0, "wrench.max_tilt");
   RequireFinite(rotation_angle, "wrench.rotation_angle");
@@ -68,6 +76,11 @@ void WrenchParams::Validate() const {
       throw InvalidArgument("wrench.joint_safe_frame: unknown value " +
                             std::to_string(static_cast<int>(joint_safe_frame)));
   }
+}
+
+double EffectiveForceTolerance(const WrenchParams& params, double tube_weight) {
+  if (params.force_tolerance_share <= 0.0) return params.force_tolerance;
+  return std::min(params.force_tolerance, params.force_tolerance_share * tube_weight);
 }
 
 std::string ToString(ResolutionVariant variant) {

@@ -42,6 +42,10 @@ struct WrenchParams {
   /// F_tol of Algorithm 3, newtons: half-width of the "single tube" band around the expected
   /// force. Must be below one tube's weight, else an empty gripper reads as holding one tube.
   double force_tolerance = 0.25;
+  /// Beyond the thesis: when > 0, the band's half-width is at most this share of one tube's weight
+  /// (EffectiveForceTolerance). Algorithm 3's fixed F_tol is 0.46 of a 55 g PVC tube's weight, wide
+  /// enough to read a tube with half another hanging from it as one; in [0, 1), 0 = F_tol alone.
+  double force_tolerance_share = 0.0;
   /// The upward vertical at lift time, in the TCP (= sensor-axes) frame; the gripper is vertical
   /// at lift (§5.2.4.1). The thesis's sensor has +z up; a TCP whose z is the approach direction
   /// (pointing down) uses (0, 0, -1). Normalised before use.
@@ -69,6 +73,10 @@ struct WrenchParams {
   /// value.
   void Validate() const;
 };
+
+/// The half-width of Algorithm 3's single band for a tube of `tube_weight` newtons:
+/// force_tolerance, or force_tolerance_share · tube_weight when that share is set and smaller.
+double EffectiveForceTolerance(const WrenchParams& params, double tube_weight);
 
 /// "torque_axis", "torque_axis_negative", "perpendicular", "joint_safe",
 /// "torque_axis_then_perpendicular".

@@ -348,16 +348,37 @@ TEST(RunAnalyzeWrench, OneTubeIsSingle) {
 }
 
 TEST(RunAnalyzeWrench, BandEdgesFollowAlgorithm3) {
-  // F_tol = 0.25 N: 0.29 N gained (< weight − F_tol = 0.28955) is none; 0.30 N single;
-  // 0.78 N single; 0.80 N (> weight + F_tol = 0.78955) multiple.
-  const auto outcome = [](double gained_newtons) {
-    return Analyze(WrenchRequest(gained_newtons / kWeight, Eigen::Vector3d::Zero())).outcome();
+  // The thesis profile: F_tol = 0.25 N: 0.28 N gained (< weight − F_tol = 0.28955) is none, 0.30 N
+  // single; 0.78 N single, 0.80 N (> weight + F_tol = 0.78955) multiple.
+  PlanningDefaults thesis;
+  thesis.profile = "thesis";
+  const auto outcome = [&](double gained_newtons) {
+    return RunAnalyzeWrench(ValidateAnalyzeWrench(
+                                WrenchRequest(gained_newtons / kWeight, Eigen::Vector3d::Zero()), thesis))
+        .outcome();
   };
   EXPECT_EQ(outcome(0.0), v1::HELD_OUTCOME_NONE);
   EXPECT_EQ(outcome(0.28), v1::HELD_OUTCOME_NONE);
   EXPECT_EQ(outcome(0.30), v1::HELD_OUTCOME_SINGLE);
   EXPECT_EQ(outcome(0.78), v1::HELD_OUTCOME_SINGLE);
   EXPECT_EQ(outcome(0.80), v1::HELD_OUTCOME_MULTIPLE);
+}
+
+TEST(RunAnalyzeWrench, TheFastProfilesBandIsAFifthOfATubesWeight) {
+  // F_tol = min(0.25 N, 0.2 · 0.53955 N) = 0.10791 N: single from 0.43164 to 0.64746 N gained.
+  // A tube with a third of another hanging from it (1.3 tubes, 0.70 N) is several, as it is not
+  // with the thesis' 0.25 N (up to 1.46 tubes).
+  const auto analyze = [](double gained_newtons) {
+    return Analyze(WrenchRequest(gained_newtons / kWeight, {0.03, 0.0, 0.0}));
+  };
+  EXPECT_NEAR(analyze(0.5).force_tolerance(), 0.2 * kWeight, 1e-12);
+  EXPECT_EQ(analyze(0.42).outcome(), v1::HELD_OUTCOME_NONE);
+  EXPECT_EQ(analyze(0.44).outcome(), v1::HELD_OUTCOME_SINGLE);
+  EXPECT_EQ(analyze(0.64).outcome(), v1::HELD_OUTCOME_SINGLE);
+  EXPECT_EQ(analyze(0.66).outcome(), v1::HELD_OUTCOME_MULTIPLE);
+  const v1::AnalyzeWrenchResponse partial = analyze(1.3 * kWeight);
+  EXPECT_EQ(partial.outcome(), v1::HELD_OUTCOME_MULTIPLE);
+  EXPECT_GT(partial.resolution_motions_size(), 0);
 }
 
 TEST(RunAnalyzeWrench, NothingHeldIsNone) {

@@ -128,6 +128,31 @@ TEST(HeldCount, ToleranceNotBelowWeightRejected) {
   EXPECT_THAT(error, HasSubstr("wrench.force_tolerance: 0.5 N is not below the weight of one tube"));
 }
 
+TEST(HeldCount, AShareNarrowsTheBandOfALightTube) {
+  // Weight 0.5 N, share 0.25: F_tol = min(0.25, 0.125) = 0.125 N, single from 9.375 to 9.625 N.
+  WrenchParams params = ExactParams();
+  params.force_tolerance_share = 0.25;
+  const HeldCount edge = CountHeldTubes(kReference, kExpected - 0.125, kMass, params);
+  EXPECT_EQ(edge.outcome, HeldOutcome::kSingle);
+  EXPECT_EQ(edge.force_tolerance, 0.125);
+  // 1.3 tubes: single with the thesis' 0.25 N, several with the share.
+  const double partial = kReference - 1.3 * 0.5;
+  EXPECT_EQ(CountHeldTubes(kReference, partial, kMass, ExactParams()).outcome, HeldOutcome::kSingle);
+  EXPECT_EQ(CountHeldTubes(kReference, partial, kMass, params).outcome, HeldOutcome::kMultiple);
+  EXPECT_EQ(CountHeldTubes(kReference, kReference - 0.7 * 0.5, kMass, params).outcome, HeldOutcome::kNone);
+  // A heavy tube keeps F_tol: weight 2 N, share · weight 0.5 N > 0.25 N.
+  EXPECT_EQ(CountHeldTubes(kReference, kReference - 2.0, 0.25, params).force_tolerance, kTolerance);
+}
+
+TEST(HeldCount, ShareOutOfRangeRejectedNamingField) {
+  WrenchParams params = ExactParams();
+  params.force_tolerance_share = 1.0;
+  EXPECT_THAT(ErrorOf([&] { CountHeldTubes(kReference, kExpected, kMass, params); }),
+              HasSubstr("wrench.force_tolerance_share: 1 is out of range [0, 1)"));
+  params.force_tolerance_share = -0.1;
+  EXPECT_THAT(ErrorOf([&] { params.Validate(); }), HasSubstr("wrench.force_tolerance_share: -0.1"));
+}
+
 TEST(HeldCount, NonFiniteForceRejected) {
   const std::string error = ErrorOf([] { CountHeldTubes(kReference, std::nan(""), kMass, ExactParams()); });
   EXPECT_THAT(error, HasSubstr("fz: value must be finite"));
