@@ -10,15 +10,15 @@ namespace tubepick {
 /// Whether a cell's lifts weigh what its tube.mass says.
 ///
 /// Algorithm 3 (CountHeldTubes) reads every lift against tube.mass. With it wrong, single picks read as
-/// none or several once the error passes wrench.force_tolerance (0.25 N: 0.46 of the 0.055 kg PVC
-/// tube's weight, 0.23 of the 0.110 kg rubber hose's), and the cell releases or shakes tubes it holds
-/// alone, again and again, with nothing naming the cause. With the right mass the lifts weigh about a
-/// whole number of tubes: in the simulated cell, 144 lifts of pvc and rubber bins of sets A, B and C
-/// weighed 0.93–1.04 tubes when single and 1.98–3.00 when several, but for two entangled rubber lifts
-/// of 5.32 and 5.42. A lift the gripper holds through weighs at least one tube: one that reads about
-/// none (a mass ten times too high, kilograms for a tenth) fits nothing, nor does one of more tubes
-/// than a grasp lifts (a mass ten times too low). A mass off by a small whole factor (half the real
-/// one) is not seen this way: every lift then weighs two tubes.
+/// none or several once the error passes the single band (EffectiveForceTolerance: the fast
+/// profile's 0.2 of a tube's weight, the thesis' 0.25 N: 0.46 of the 0.055 kg PVC tube's weight), and the
+/// cell releases or shakes tubes it holds alone, again and again, with nothing naming the cause. With the
+/// right mass the lifts weigh about a whole number of tubes: in the simulated cell, 144 lifts of pvc and
+/// rubber bins of sets A, B and C weighed 0.93–1.04 tubes when single and 1.98–3.00 when several, but for two
+/// entangled rubber lifts of 5.32 and 5.42. A lift the gripper holds through weighs at least one tube: one
+/// that reads about none (a mass ten times too high, kilograms for a tenth) fits nothing, nor does one of
+/// more tubes than a grasp lifts (a mass ten times too low). A mass off by a small whole factor (half the
+/// real one) is not seen this way: every lift then weighs two tubes.
 struct TubeMassCheckParams {
   /// The most recent lifts looked at ...
   std::uint32_t window = 5;
