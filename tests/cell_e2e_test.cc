@@ -6,11 +6,13 @@
 #include <csignal>
 #include <functional>
 #include <string>
+#include <thread>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
 #include "clients/cell/cell_statistics.h"
 #include "clients/cell/planner_client.h"
+#include "clients/cli/cell/operator_stop.h"
 #include "clients/cli/cell/planner_outage.h"
 #include "clients/cli/cell/sim_round.h"
 #include "devices/sim/sim_cell.h"
@@ -211,6 +213,40 @@ TEST_F(CellEndToEndTest, ServerGoneWhileATubeIsHeldIsAnalysedLocallyThenTheRound
 }
 
 #ifdef TUBEPICK_SERVER
+TEST_F(CellEndToEndTest, AStopWhileHoldingATreeOverAHighHeapReleasesItOnTheHeapNotPressedIntoIt) {
+  // 20 pvc set-C trees: the heap under the bin's middle is higher than a held tree hangs at the
+  // safe release height. The operator's Ctrl-C comes as the first lifted tree is to be analysed.
+  cell::GrpcPlannerClient planner(address());
+  cell::MemoryRecordSink sink;
+  devices::sim::SimCellParams sim_params =
+      devices::sim::SimCellParams::Thesis(devices::sim::Material::kPvc, 20, 8);
+  cli::WithShapes("C", &sim_params);
+  devices::sim::SimCell sim(sim_params);
+  cell::CellControllerParams params;
+  params.seed = 8000;
+  cli::OperatorStop stop;
+  bool raised = false;
+  const auto ctrl_c_at_analyze = [&](cell::CellState state) {
+    if (state != cell::CellState::kAnalyze || raised) return;
+    ASSERT_FALSE(sim.HeldTubes().empty());
+    std::raise(SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the watcher polls every 20 ms
+    raised = true;
+  };
+  const cli::SimRoundResult r = cli::RunSimRound(planner, sim, params, 0, &sink, ctrl_c_at_analyze, &stop);
+
+  ASSERT_TRUE(raised);
+  EXPECT_EQ(r.run.reason, cell::CellStopReason::kStopped) << r.run.message;
+  ASSERT_TRUE(r.run.safe_stop);
+  EXPECT_EQ(r.run.safe_stop->action, "released_in_bin") << r.run.message;
+  // Opened where the tree came to rest, well above the release height the one move went to.
+  ASSERT_TRUE(r.run.safe_stop->p_Bin_tcp);
+  EXPECT_GT(r.run.safe_stop->p_Bin_tcp->z(), params.safe_release_height + 0.05) << r.run.message;
+  EXPECT_NE(r.run.message.find("rests on the heap"), std::string::npos) << r.run.message;
+  EXPECT_EQ(r.tubes_in_bin, 20u);
+  EXPECT_EQ(r.tubes_elsewhere, 0u);
+}
+
 TEST(PlannerProcessTest, APlannerKilledBetweenCallsIsGivenUpAfterTheUnavailableBudgetNotTheDeadline) {
   // tubepick-server as a process, killed after one call (SIGTERM then SIGKILL at once, as the
   // fault campaign's outage does). The next PlanPick must end within the unavailable budget

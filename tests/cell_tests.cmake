@@ -14,7 +14,8 @@ if(TARGET tubepick-server)
   tubepick_add_test(cell_cli_test SOURCES cell_cli_test.cc LIBS nlohmann_json::nlohmann_json)
   target_include_directories(cell_cli_test PRIVATE ${PROJECT_SOURCE_DIR})
   add_dependencies(cell_cli_test tubepick tubepick-server)
-  target_compile_definitions(cell_cli_test PRIVATE TUBEPICK_CLI="$<TARGET_FILE:tubepick>")
+  target_compile_definitions(cell_cli_test PRIVATE TUBEPICK_CLI="$<TARGET_FILE:tubepick>"
+                                                   TUBEPICK_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   # `tubepick cell --devices` against `tubepick virtual-cell` (the real drivers, the real protocols),
   # `tubepick devices check`, and the operator's Ctrl-C.
   tubepick_add_test(cell_devices_cli_test SOURCES cell_devices_cli_test.cc LIBS nlohmann_json::nlohmann_json)

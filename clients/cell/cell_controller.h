@@ -359,8 +359,9 @@ class CellController {
   void SafeStop(const StopCause& cause, CellRunResult& result);
   /// Throws StopRequested when a stop was requested and the run is not stopping already.
   void CheckStop();
-  /// Holding: over the bin, down to the release height, open, up; says what it did and could not.
-  std::string ReturnHeldTubeToBin(SafeStopOutcome& outcome);
+  /// Holding: over the bin, down to the release height (in F/T-read steps when `ft_usable`:
+  /// DescendIntoBin), open, up; says what it did and could not.
+  std::string ReturnHeldTubeToBin(SafeStopOutcome& outcome, bool ft_usable);
   /// The release pose over the bin's middle, x_Tcp turned (about the vertical) along the bin's long
   /// side so that the held tube hangs along it.
   /// After the safe stop opened over the bin: what still hangs on the tool (against
@@ -368,6 +369,15 @@ class CellController {
   /// nullopt when nothing was caught or it fell off. Never throws.
   std::optional<std::string> LoadStillCaught();
   Eigen::Isometry3d SafeReleasePose(const Eigen::Isometry3d& X_BinTcpNow) const;
+  /// From straight above X_BinTcpRelease down towards it in safe_release_step steps, reading the
+  /// F/T after each: returns the pose where the held tube came to rest on the heap (the load
+  /// changed by more than half a tube's weight, or the readings disagree), or X_BinTcpRelease once
+  /// there. An F/T that does not answer ends the readings: straight down. `rest` says which. Robot
+  /// errors are thrown.
+  Eigen::Isometry3d DescendIntoBin(const Eigen::Isometry3d& X_BinTcpRelease, std::string* rest);
+  /// One F/T measurement during the safe stop; nullopt when it fails. With `pressing`, readings
+  /// that keep disagreeing set it (the held tube pressing on something) instead of `rest`.
+  std::optional<devices::WrenchReading> SafeStopReading(std::string* rest, bool* pressing = nullptr);
 
   // One picking attempt (cell_attempt.cc): approach, reference, grasp, lift, analyze, then place,
   // resolve or put back.

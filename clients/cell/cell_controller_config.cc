@@ -117,6 +117,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
     "m: down to the place pose in steps, opening where the tube rests; 0 = one move");
   v("safe_release_height", p.safe_release_height,
     "m above the bin floor: a safe stop holding a tube opens there, over the bin's middle");
+  v("safe_release_step", p.safe_release_step,
+    "m: down to it in steps, opening where the tube rests on the heap; 0 = one move");
   v.OptionalPose("home_pose_in_bin", p.X_BinHome,
                  "where the robot waits while the bin is scanned (X_BinHome);\n"
                  "null: above the place frame at transit height, TCP down");

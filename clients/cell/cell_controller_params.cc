@@ -56,6 +56,7 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
   RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
   RequireNonNegativeValue(place_step, "place_step");
+  RequireNonNegativeValue(safe_release_step, "safe_release_step");
   RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
     throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");
@@ -112,19 +113,24 @@ double TransitHeight(const CellControllerParams& params, const CellConfig& cell)
   return cell.bin.inner_size.z() + params.transit_clearance;
 }
 
-std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,
-                                                 const Eigen::Isometry3d& X_BinTcpFrom,
-                                                 const Eigen::Isometry3d& X_BinTcpPlace) {
-  const double height = X_BinTcpFrom.translation().z() - X_BinTcpPlace.translation().z();
-  if (!(params.place_step > 0.0) || !(height > params.place_step)) return {};
-  const int steps = static_cast<int>(std::ceil(height / params.place_step - 1e-9));
+std::vector<Eigen::Isometry3d> DescentSteps(double step, const Eigen::Isometry3d& X_BinTcpFrom,
+                                            const Eigen::Isometry3d& X_BinTcpTo) {
+  const double height = X_BinTcpFrom.translation().z() - X_BinTcpTo.translation().z();
+  if (!(step > 0.0) || !(height > step)) return {};
+  const int steps = static_cast<int>(std::ceil(height / step - 1e-9));
   std::vector<Eigen::Isometry3d> out;
   for (int k = 1; k < steps; ++k) {
-    Eigen::Isometry3d X_BinTcpStep = X_BinTcpPlace;
+    Eigen::Isometry3d X_BinTcpStep = X_BinTcpTo;
     X_BinTcpStep.translation().z() += height * (1.0 - static_cast<double>(k) / steps);
     out.push_back(X_BinTcpStep);
   }
   return out;
+}
+
+std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,
+                                                 const Eigen::Isometry3d& X_BinTcpFrom,
+                                                 const Eigen::Isometry3d& X_BinTcpPlace) {
+  return DescentSteps(params.place_step, X_BinTcpFrom, X_BinTcpPlace);
 }
 
 Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell) {

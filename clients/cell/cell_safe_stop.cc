@@ -6,10 +6,14 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/local_wrench_analysis.h"
 
 namespace tubepick::cell {
 namespace {
@@ -53,7 +57,9 @@ void CellController::SafeStop(const StopCause& cause, CellRunResult& result) {
       note += fmt::format(" (the robot did not report its pose: {})", e.what());
     }
   } else {
-    note = ReturnHeldTubeToBin(outcome);
+    // A stop the F/T caused (lost, disagreeing, a load on the open tool) does not read it again.
+    const bool ft_usable = !(cause.fault && cause.fault->device() == "ft_sensor");
+    note = ReturnHeldTubeToBin(outcome, ft_usable);
   }
   result.safe_stop = outcome;
   if (cause.fault) {
@@ -99,7 +105,52 @@ Eigen::Isometry3d CellController::SafeReleasePose(const Eigen::Isometry3d& X_Bin
   return X_BinTcpRelease;
 }
 
-std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
+Eigen::Isometry3d CellController::DescendIntoBin(const Eigen::Isometry3d& X_BinTcpRelease,
+                                                 std::string* rest) {
+  const Eigen::Isometry3d X_BinTcpAbove = WithHeight(X_BinTcpRelease, TransitHeight(params_, cell_));
+  const std::vector<Eigen::Isometry3d> steps =
+      DescentSteps(params_.safe_release_step, X_BinTcpAbove, X_BinTcpRelease);
+  std::optional<devices::WrenchReading> over_bin;
+  if (!steps.empty()) over_bin = SafeStopReading(rest);
+  // Half a tube's weight: the held tube resting on the heap lightens the load by about its weight
+  // (or more, the tool pressing); a swing after a step does not.
+  const double contact = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
+  for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
+    if (!over_bin) break;
+    devices_.robot->MoveTo(X_BinTcpStep, params_.approach_speed, params_.robot_timeout);
+    bool pressing = false;
+    const std::optional<devices::WrenchReading> now = SafeStopReading(rest, &pressing);
+    const double change = now ? (now->force - over_bin->force).norm() : 0.0;
+    if (pressing || change > contact) {
+      *rest = pressing ? ", where the F/T readings started to disagree (resting on the heap)"
+                       : fmt::format(", where it rests on the heap (the load changed by {:.2f} N)", change);
+      spdlog::warn("cell: safe stop: the held tube rests on the heap at X_BinTcp z {:.3f} m: opening there",
+                   X_BinTcpStep.translation().z());
+      return X_BinTcpStep;
+    }
+    if (!now) break;
+  }
+  devices_.robot->MoveTo(X_BinTcpRelease, params_.approach_speed, params_.robot_timeout);
+  return X_BinTcpRelease;
+}
+
+std::optional<devices::WrenchReading> CellController::SafeStopReading(std::string* rest, bool* pressing) {
+  try {
+    return ReadWrench();
+  } catch (const CellFault& fault) {
+    if (pressing && fault.device() == "ft_sensor" && fault.kind() == FaultKind::kDeviceFault) {
+      *pressing = true;  // readings that keep disagreeing below a steady one: pressing on the heap
+      return std::nullopt;
+    }
+    *rest = fmt::format(" (the F/T did not answer on the way down: {}; lowered without it)", fault.error());
+  } catch (const std::exception& e) {
+    *rest = fmt::format(" (the F/T did not answer on the way down: {}; lowered without it)", e.what());
+  }
+  spdlog::warn("cell: safe stop:{}", *rest);
+  return std::nullopt;
+}
+
+std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome, bool ft_usable) {
   const std::string what = held_ == Held::kTube ? "a tube" : "possibly a tube";
   outcome.action = "kept_closed";
   Eigen::Isometry3d X_BinTcp;
@@ -112,12 +163,18 @@ std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
   outcome.p_Bin_tcp = X_BinTcp.translation();
   const double z_transit = TransitHeight(params_, cell_);
   const Eigen::Isometry3d X_BinTcpRelease = SafeReleasePose(X_BinTcp);
+  Eigen::Isometry3d X_BinTcpOpen = X_BinTcpRelease;
+  std::string rest;
   try {
     if (X_BinTcp.translation().z() < z_transit - kSameHeight)
       devices_.robot->MoveTo(WithHeight(X_BinTcp, z_transit), params_.transit_speed, params_.robot_timeout);
     devices_.robot->MoveTo(WithHeight(X_BinTcpRelease, z_transit), params_.transit_speed,
                            params_.robot_timeout);
-    devices_.robot->MoveTo(X_BinTcpRelease, params_.approach_speed, params_.robot_timeout);
+    if (ft_usable) {
+      X_BinTcpOpen = DescendIntoBin(X_BinTcpRelease, &rest);
+    } else {
+      devices_.robot->MoveTo(X_BinTcpRelease, params_.approach_speed, params_.robot_timeout);
+    }
   } catch (const std::exception& e) {
     try {
       outcome.p_Bin_tcp = devices_.robot->CurrentPose(params_.robot_timeout).translation();
@@ -126,7 +183,7 @@ std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
     return fmt::format("HOLDING {} at X_BinTcp {}: the robot cannot move ({}); gripper kept closed", what,
                        FormatPosition(*outcome.p_Bin_tcp), e.what());
   }
-  outcome.p_Bin_tcp = X_BinTcpRelease.translation();
+  outcome.p_Bin_tcp = X_BinTcpOpen.translation();
   try {
     const devices::GripperStatus status = devices_.gripper->Open(params_.gripper_timeout);
     if (status.fault != 0)
@@ -146,8 +203,8 @@ std::string CellController::ReturnHeldTubeToBin(SafeStopOutcome& outcome) {
   }
   held_ = Held::kNothing;
   outcome.action = "released_in_bin";
-  std::string note =
-      fmt::format("{} released into the bin at X_BinTcp {}", what, FormatPosition(*outcome.p_Bin_tcp));
+  std::string note = fmt::format("{} released into the bin at X_BinTcp {}{}", what,
+                                 FormatPosition(*outcome.p_Bin_tcp), rest);
   try {
     devices_.robot->MoveTo(WithHeight(X_BinTcpRelease, z_transit), params_.transit_speed,
                            params_.robot_timeout);

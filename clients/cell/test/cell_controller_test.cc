@@ -1578,6 +1578,80 @@ TEST_F(CellControllerTest, StopWhileHoldingATubeReleasesItOverTheBin) {
   EXPECT_EQ(end["message"], result.message);
 }
 
+// ---------------------------------------------------------------- the safe stop's descent
+
+class SafeStopDescentTest : public CellControllerTest {
+ protected:
+  void SetUp() override {
+    CellControllerTest::SetUp();
+    planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+    planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+    observer = [this](CellState state) {
+      if (state == CellState::kAnalyze) running->RequestStop("operator stop (SIGINT)");
+    };
+    ft.tcp = &robot.X_BinTcp;
+  }
+  /// Heights (bin z) the robot stopped at over the bin's middle, below the transit height, in order.
+  std::vector<double> StopsOverTheBin() const {
+    std::vector<double> z;
+    for (const auto& m : robot.moves) {
+      const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+      if (!m.through && q.head<2>().norm() < kTol && q.z() < TransitHeight(params, cell) - kTol)
+        z.push_back(q.z());
+    }
+    return z;
+  }
+};
+
+TEST_F(SafeStopDescentTest, AHeldTubeThatRestsOnTheHeapIsReleasedThereNotPushedIn) {
+  // Transit at 0.5 m, release at 0.15: 12 steps of 0.35 / 12 m. The heap takes the tube's weight
+  // from 0.45 m down: the second step.
+  ft.rests_below_z = 0.45;
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  const std::vector<double> stops = StopsOverTheBin();
+  ASSERT_EQ(stops.size(), 2u);
+  EXPECT_NEAR(stops[0], 0.5 - 0.35 / 12, kTol);
+  EXPECT_NEAR(stops[1], 0.5 - 0.35 / 6, kTol);
+  ASSERT_EQ(gripper.opened_at.size(), 2u);
+  EXPECT_TRUE(gripper.opened_at[1].isApprox(Eigen::Vector3d(0.0, 0.0, stops[1]), kTol));
+  EXPECT_THAT(result.message,
+              ::testing::HasSubstr("released into the bin at X_BinTcp (0.000, 0.000, 0.442) m, "
+                                   "where it rests on the heap (the load changed by 0.54 N)"));
+}
+
+TEST_F(SafeStopDescentTest, AHeldTubeOverALowHeapGoesDownToTheReleaseHeightInSteps) {
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.safe_stop);
+  const std::vector<double> stops = StopsOverTheBin();
+  ASSERT_EQ(stops.size(), 12u);  // 11 steps, then the release height
+  for (std::size_t i = 0; i < stops.size(); ++i) EXPECT_NEAR(stops[i], 0.5 - 0.35 * (i + 1) / 12, kTol) << i;
+  EXPECT_TRUE(gripper.opened_at.back().isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
+}
+
+TEST_F(SafeStopDescentTest, AnFtThatStopsAnsweringOnTheWayDownLowersTheTubeWithoutIt) {
+  observer = [this](CellState state) {
+    if (state == CellState::kAnalyze) running->RequestStop("operator stop (SIGINT)");
+    if (state == CellState::kSafeStop) ft.fail_read_from = ft.reads + 2;  // over the bin, one step
+  };
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.safe_stop);
+  EXPECT_EQ(result.safe_stop->action, "released_in_bin");
+  EXPECT_TRUE(gripper.opened_at.back().isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
+  EXPECT_THAT(result.message, ::testing::HasSubstr("the F/T did not answer on the way down"));
+  EXPECT_EQ(StopsOverTheBin().size(), 3u);  // two steps, then straight down
+}
+
+TEST_F(SafeStopDescentTest, WithoutStepsItIsOneMove) {
+  params.safe_release_step = 0.0;
+  ft.rests_below_z = 0.45;  // not read
+  const CellRunResult result = Run();
+  ASSERT_TRUE(result.safe_stop);
+  ASSERT_EQ(StopsOverTheBin().size(), 1u);
+  EXPECT_TRUE(gripper.opened_at.back().isApprox(Eigen::Vector3d(0.0, 0.0, params.safe_release_height), kTol));
+}
+
 TEST_F(CellControllerTest, StopAtTheScanStopsWithNothingHeld) {
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   observer = [this](CellState state) {

@@ -200,12 +200,18 @@ class ScriptedForceTorque final : public devices::ForceTorqueSensor {
   Failure failure{true, "ATI Net F/T: no RDT packet within 2000 ms"};
   /// Reads (0-based) that time out once.
   std::vector<int> fail_once_at;
+  /// A heap under the tool: while the gripper holds and the TCP (`tcp`) is at or below this height
+  /// (bin z), the held tube rests on it and the load reads as the empty tool's (zero).
+  std::optional<double> rests_below_z;
+  const Eigen::Isometry3d* tcp = nullptr;
   int biases = 0, reads = 0;
 
   devices::WrenchReading Read(devices::Timeout) override {
     const int i = reads++;
     if (fail_read_from && i >= *fail_read_from) failure.Throw();
     if (std::find(fail_once_at.begin(), fail_once_at.end(), i) != fail_once_at.end()) failure.Throw();
+    if (rests_below_z && tcp && tcp->translation().z() <= *rests_below_z + 1e-9 && holding && *holding)
+      return devices::WrenchReading{};
     if (readings.empty()) {
       if (queued && (!holding || *holding)) return last;  // the load has not changed
       devices::WrenchReading r;  // nothing scripted: the load follows what the gripper holds
