@@ -116,8 +116,16 @@ std::string DescribeTubeMassDoubt(const CellRunResult& result) {
                      result.attempts, result.tube_mass_doubt);
 }
 
+std::string DescribeVanishedOverWalls(const CellRunResult& result) {
+  const std::size_t n = result.vanished_over_walls.size();
+  if (n == 0) return "";
+  return fmt::format("; {} hanging over a wall {} not seen again, {} have fallen out of the bin: {}",
+                     Count(static_cast<std::uint32_t>(n), "tube"), n == 1 ? "was" : "were",
+                     n == 1 ? "it may" : "they may", fmt::join(result.vanished_over_walls, "; "));
+}
+
 std::string DescribeRoundWarnings(const CellRunResult& result) {
-  return DescribePlannerWarnings(result) + DescribeTubeMassDoubt(result);
+  return DescribePlannerWarnings(result) + DescribeTubeMassDoubt(result) + DescribeVanishedOverWalls(result);
 }
 
 std::string ToString(CellStopReason reason) {
@@ -279,7 +287,28 @@ CellController::PlannedScan CellController::ScanBin(RunState& run) {
   PlanPick(capture, scan);
   for (const v1::ModelingWarning& w : scan.response.modeling().warnings())
     ++run.result.planner_warnings[w.code()];
+  WatchWalls(scan, run);
   return scan;
+}
+
+void CellController::WatchWalls(PlannedScan& scan, RunState& run) {
+  for (const TubeOverWall& gone :
+       VanishedOverWalls(run.over_walls, scan.response, run.touched, params_.wall_watch)) {
+    const std::string what = Describe(gone);
+    spdlog::warn(
+        "cell: round {} scan {}: a tube hung {} though no attempt took it: it may have fallen out of the "
+        "bin (check the floor beside that wall)",
+        round_, scan.index, what);
+    run.result.vanished_over_walls.push_back(what);
+    scan.vanished_over_walls.push_back(what);
+  }
+  run.over_walls = TubesOverWalls(scan.response, cell_.bin, scan.index, params_.wall_watch);
+  run.touched.clear();
+}
+
+void CellController::TakeVanishedOverWalls(PlannedScan& scan, nlohmann::json& record) {
+  if (scan.vanished_over_walls.empty()) return;
+  record["vanished_over_walls"] = std::exchange(scan.vanished_over_walls, {});
 }
 
 void CellController::PlanPick(const devices::Capture& capture, PlannedScan& scan) {
@@ -345,6 +374,8 @@ CellController::Attempt& CellController::BeginAttempt(PlannedScan& scan, int ran
   ++run.attempts_since_pick;
   attempt.record = BaseRecord(scan, rank, run.result.attempts);
   attempt.record["skipped_plans"] = std::exchange(scan.skipped, nlohmann::json::array());
+  TakeVanishedOverWalls(scan, attempt.record);
+  run.touched.push_back(scan.response.plans(rank).tube_id());
   if (first_of_scan) {
     attempt.started = scan.started;
     attempt.device_started = scan.device_started;
@@ -456,6 +487,7 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
   const std::optional<NudgePlan> nudge =
       cell_mismatch ? std::nullopt : PlanNudgeIfAllowed(scan.response, run);
   nlohmann::json record = BaseRecord(scan, 0, run.result.attempts);
+  TakeVanishedOverWalls(scan, record);
   record["attempt"] = nullptr;
   record["result"] = "no_plan";
   record["skipped_plans"] = std::exchange(scan.skipped, nlohmann::json::array());
@@ -493,6 +525,7 @@ nlohmann::json CellController::Nudge(const NudgePlan& nudge, nlohmann::json reco
                                      RunState& run) {
   ++run.result.nudges;
   ++run.nudges_since_pick;
+  run.touched.push_back(nudge.tube_id);
   record["nudge"] = NudgeJson(nudge);
   Attempt& attempt = run.active.emplace();
   attempt.record = std::move(record);

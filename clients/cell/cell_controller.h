@@ -116,6 +116,9 @@ struct CellRunResult {
   /// tube.mass (CheckTubeMass), and the last such doubt ("" when none).
   std::uint32_t tube_mass_doubts = 0;
   std::string tube_mass_doubt;
+  /// Tubes seen hanging over a wall that a later scan no longer showed though no attempt took them
+  /// (VanishedOverWalls): they may have fallen out of the bin. Describe(TubeOverWall) each.
+  std::vector<std::string> vanished_over_walls;
 };
 
 /// "; the planner warned: tube_length_shorter_than_scan in 8 of 8 scans (check the cell)" for the
@@ -125,6 +128,9 @@ std::string DescribePlannerWarnings(const CellRunResult& result);
 /// "; the lifts doubt tube.mass after 4 of 6 attempts: <the last doubt>" for the round's line, or ""
 /// when no lift of the round did.
 std::string DescribeTubeMassDoubt(const CellRunResult& result);
+/// "; 1 tube hanging over a wall was not seen again, it may have fallen out of the bin: over the
+/// -y wall at ... m, not seen again after scan 5", or "".
+std::string DescribeVanishedOverWalls(const CellRunResult& result);
 
 /// Both of the above, as the round's line ends.
 std::string DescribeRoundWarnings(const CellRunResult& result);
@@ -332,6 +338,11 @@ class CellController {
   bool ScanAndPick(RunState& run);
   PlannedScan ScanBin(RunState& run);
   void PlanPick(const devices::Capture& capture, PlannedScan& scan);
+  /// Tubes the last scan showed hanging over a wall that this one does not, though no attempt or
+  /// nudge took them: logged, recorded with the next record and on the round's result.
+  void WatchWalls(PlannedScan& scan, RunState& run);
+  /// Moves the scan's vanished_over_walls into `record` (the first record of the scan).
+  static void TakeVanishedOverWalls(PlannedScan& scan, nlohmann::json& record);
   /// The scan's plans in rank order, skipping those that cannot be executed; returns how many ran.
   std::uint32_t TryPlans(PlannedScan& scan, RunState& run);
   AttemptResult PickAttempt(PlannedScan& scan, int rank, bool first_of_scan, RunState& run);

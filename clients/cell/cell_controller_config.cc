@@ -88,6 +88,14 @@ void DescribeFields(Visit& v, CellFrameCheckParams& c) {
 }
 
 template <typename Visit>
+void DescribeFields(Visit& v, WallWatchParams& w) {
+  v("enabled", w.enabled, "warn when a tube seen hanging over a wall is gone at the next scan");
+  v("below_top", w.below_top, "m: a tube's axis this close below the wall top or higher ...");
+  v("from_wall", w.from_wall, "m: ... and this close to the wall's inner face or past it hangs over it");
+  v("gone_distance", w.gone_distance, "m: gone when no tube axis of the next scan comes this close");
+}
+
+template <typename Visit>
 void DescribeFields(Visit& v, LiftWeightCheckParams& c) {
   v("enabled", c.enabled, "warn when the lifts' weights fit no whole number of tubes of tube.mass");
   v("window", c.limits.window, "the most recent lifts, judged together");
@@ -184,6 +192,9 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
             "every attempt)");
   v.Heading("scanner");
   v("scan_retries", p.scan_retries, "scans again after a timeout or an empty scan");
+  v.Section("wall_watch", p.wall_watch,
+            "a tube a scan shows hanging over a wall that the next scan does not show, though no\n"
+            "attempt took it, may have fallen out of the bin: logged, recorded, on the round's line");
   DescribePlannerFields(v, p);
   DescribeLimitFields(v, p);
 }

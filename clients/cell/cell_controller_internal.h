@@ -128,6 +128,9 @@ struct CellController::RunState {
   };
   std::vector<FailedGrasp> failed_grasps;
   std::optional<Attempt> active;
+  /// The last scan's tubes hanging over a wall, and the tubes attempted or nudged since.
+  std::vector<TubeOverWall> over_walls;
+  std::vector<std::uint32_t> touched;
 };
 
 template <typename Body>
@@ -170,6 +173,8 @@ struct CellController::PlannedScan {
   /// Plans of this scan skipped because they do not fit this controller's cell, and the first reason.
   std::uint32_t cell_mismatches = 0;
   std::string first_cell_mismatch;
+  /// Tubes over a wall the scan before showed and this one does not (Describe), for the next record.
+  std::vector<std::string> vanished_over_walls;
 };
 
 /// The TCP poses of one plan, bin frame.

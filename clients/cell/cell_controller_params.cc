@@ -90,6 +90,7 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(ft_spike_torque, "ft_spike_torque");
   try {
     tube_mass_check.limits.Validate();
+    wall_watch.Validate();
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(fmt::format("cell controller {}", e.what()));
   }

@@ -10,6 +10,7 @@
 #include "clients/cell/cell_frame_check.h"
 #include "clients/cell/nudge.h"
 #include "clients/cell/tool_clearance.h"
+#include "clients/cell/wall_watch.h"
 #include "core/common/cell_config.h"
 #include "core/wrench/tube_mass_check.h"
 #include "devices/device_error.h"
@@ -121,6 +122,9 @@ struct CellControllerParams {
   /// Whether the lifts' weights still fit the cell's tube.mass (CheckTubeMass): a doubt is logged once
   /// and recorded with every attempt from then on; Algorithm 3's decisions are unchanged.
   LiftWeightCheckParams tube_mass_check;
+  /// Tubes a scan shows hanging over a wall that the next scan no longer shows, though no attempt
+  /// took them, may have fallen out of the bin: logged, recorded and named on the round's line.
+  WallWatchParams wall_watch;
 
   // --- scanner ---
   /// Further scans after a scan that timed out or returned no point, before it is a fault.

@@ -16,6 +16,7 @@ namespace tubepick::cell {
 namespace {
 
 using nlohmann::json;
+using testing::AddTubeAxis;
 using testing::DownPose;
 using testing::Failure;
 using testing::MakePlan;
@@ -1576,6 +1577,48 @@ TEST_F(CellControllerTest, StopWhileHoldingATubeReleasesItOverTheBin) {
   const json end = Records("end").at(0);
   EXPECT_EQ(end["reason"], "stopped");
   EXPECT_EQ(end["message"], result.message);
+}
+
+// ---------------------------------------------------------------- a tube over a wall
+
+TEST_F(CellControllerTest, ATubeOverAWallThatTheNextScanNoLongerShowsIsNamedOnTheRound) {
+  // Scan 0: tube 4 is picked; tube 7 leans on the -y wall, over its top. Scan 1: only tube 9, far
+  // from where tube 7 hung; it is picked. Scan 2: empty.
+  auto first = Plans({MakePlan(4, p_Bin_grasp)}, 0);
+  AddTubeAxis(first.response, 4, {{0.05, -0.05, 0.03}, {0.15, -0.05, 0.03}});
+  AddTubeAxis(first.response, 7, {{-0.08, -0.10, 0.11}, {-0.029, -0.304, 0.22}});
+  auto second = Plans({MakePlan(9, GraspSpot(3))}, 0);
+  AddTubeAxis(second.response, 9, {{0.0, 0.1, 0.03}, {0.1, 0.1, 0.03}});
+  planner.plan_answers = {first, second};
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  ASSERT_EQ(result.vanished_over_walls.size(), 1u);
+  EXPECT_EQ(result.vanished_over_walls[0],
+            "over the -y wall at (-0.029, -0.304, 0.220) m, not seen again after scan 0");
+  EXPECT_THAT(DescribeRoundWarnings(result),
+              ::testing::HasSubstr(
+                  "1 tube hanging over a wall was not seen again, it may have fallen out of the bin"));
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 2u);
+  EXPECT_FALSE(attempts[0].contains("vanished_over_walls"));
+  EXPECT_EQ(attempts[1]["vanished_over_walls"].size(), 1u);
+}
+
+TEST_F(CellControllerTest, ATubeOverAWallThatAnAttemptTookIsNotMissed) {
+  // Along x over the +x wall, grasped at its middle: the place lays it on the place frame (the
+  // cell check).
+  auto first = Plans({MakePlan(7, {0.195, 0.0, 0.1875})}, 0);
+  AddTubeAxis(first.response, 7, {{0.0, 0.0, 0.17}, {0.39, 0.0, 0.205}});
+  ASSERT_EQ(TubesOverWalls(first.response, cell.bin, 0, params.wall_watch).size(), 1u);
+  planner.plan_answers = {first};
+  params.check_tool_clearance = false;
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(result.vanished_over_walls.empty());
+  EXPECT_EQ(DescribeRoundWarnings(result), "");
 }
 
 // ---------------------------------------------------------------- the safe stop's descent

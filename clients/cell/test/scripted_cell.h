@@ -321,6 +321,19 @@ inline ScriptedPlanner::PlanAnswer Plans(std::vector<v1::PickPlan> plans, int tu
   return a;
 }
 
+/// Adds tube `id` to `response`, its axis through `points` (bin frame), one 1 cm cylinder per pair.
+inline void AddTubeAxis(v1::PlanPickResponse& response, std::uint32_t id,
+                        const std::vector<Eigen::Vector3d>& points) {
+  v1::Tube* tube = response.add_tubes();
+  tube->set_id(id);
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    v1::Cylinder* c = tube->add_cylinders();
+    *c->mutable_start() = ToProto(points[i]);
+    *c->mutable_end() = ToProto(points[i + 1]);
+    c->set_radius(0.01);
+  }
+}
+
 inline v1::AnalyzeWrenchResponse Outcome(v1::HeldOutcome outcome, double ratio, int motions = 0) {
   v1::AnalyzeWrenchResponse r;
   r.set_outcome(outcome);

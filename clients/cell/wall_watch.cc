@@ -1,0 +1,86 @@
+#include "clients/cell/wall_watch.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <array>
+#include <optional>
+
+#include "core/common/require.h"
+#include "core/common/segment_geometry.h"
+
+namespace tubepick::cell {
+namespace {
+
+Eigen::Vector3d Point(const v1::Vector3& v) { return {v.x(), v.y(), v.z()}; }
+
+/// The wall `p` hangs over, or nullopt.
+std::optional<std::string> WallAt(const Eigen::Vector3d& p, const BinConfig& bin,
+                                  const WallWatchParams& params) {
+  const Eigen::Vector3d& size = bin.inner_size;
+  if (p.z() < size.z() - params.below_top) return std::nullopt;
+  const std::array<std::pair<double, const char*>, 4> walls = {{{p.x() - 0.5 * size.x(), "+x"},
+                                                                {-p.x() - 0.5 * size.x(), "-x"},
+                                                                {p.y() - 0.5 * size.y(), "+y"},
+                                                                {-p.y() - 0.5 * size.y(), "-y"}}};
+  // Signed distance past each inner face (negative inside): the nearest wall within reach.
+  const auto nearest = std::max_element(walls.begin(), walls.end(),
+                                        [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (nearest->first < -params.from_wall) return std::nullopt;
+  return std::string(nearest->second);
+}
+
+bool ShownNear(const Eigen::Vector3d& p, const v1::PlanPickResponse& response, double distance) {
+  for (const v1::Tube& tube : response.tubes()) {
+    for (const v1::Cylinder& c : tube.cylinders()) {
+      const Eigen::Vector3d a = Point(c.start());
+      if (ClosestPointsOfSegments(p, p, a, Point(c.end())).distance <= distance) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void WallWatchParams::Validate() const {
+  RequireNonNegative(below_top, "wall_watch.below_top");
+  RequireNonNegative(from_wall, "wall_watch.from_wall");
+  RequirePositive(gone_distance, "wall_watch.gone_distance");
+}
+
+std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, const BinConfig& bin,
+                                         std::uint32_t scan, const WallWatchParams& params) {
+  std::vector<TubeOverWall> out;
+  if (!params.enabled) return out;
+  for (const v1::Tube& tube : response.tubes()) {
+    std::optional<TubeOverWall> highest;
+    for (const v1::Cylinder& c : tube.cylinders()) {
+      for (const Eigen::Vector3d& p : {Point(c.start()), Point(c.end())}) {
+        const std::optional<std::string> wall = WallAt(p, bin, params);
+        if (!wall || (highest && highest->p_Bin.z() >= p.z())) continue;
+        highest = TubeOverWall{tube.id(), p, *wall, scan};
+      }
+    }
+    if (highest) out.push_back(*highest);
+  }
+  return out;
+}
+
+std::vector<TubeOverWall> VanishedOverWalls(const std::vector<TubeOverWall>& before,
+                                            const v1::PlanPickResponse& after,
+                                            const std::vector<std::uint32_t>& touched,
+                                            const WallWatchParams& params) {
+  std::vector<TubeOverWall> out;
+  for (const TubeOverWall& tube : before) {
+    if (std::find(touched.begin(), touched.end(), tube.tube_id) != touched.end()) continue;
+    if (!ShownNear(tube.p_Bin, after, params.gone_distance)) out.push_back(tube);
+  }
+  return out;
+}
+
+std::string Describe(const TubeOverWall& tube) {
+  return fmt::format("over the {} wall at ({:.3f}, {:.3f}, {:.3f}) m, not seen again after scan {}",
+                     tube.wall, tube.p_Bin.x(), tube.p_Bin.y(), tube.p_Bin.z(), tube.scan);
+}
+
+}  // namespace tubepick::cell

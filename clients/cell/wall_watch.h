@@ -1,0 +1,58 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/common/cell_config.h"
+#include "tubepick/v1/planning.pb.h"
+
+namespace tubepick::cell {
+
+/// Which scans count a tube as hanging over a wall, and when it is gone.
+struct WallWatchParams {
+  /// Off: nothing is watched.
+  bool enabled = true;
+  /// A tube hangs over a wall where a point of its axis lies no lower than this below the wall top,
+  /// m, ...
+  double below_top = 0.03;
+  /// ... and no farther than this inside the wall's inner face (or past it), m.
+  double from_wall = 0.03;
+  /// Gone when no axis of the next scan's tubes comes within this of that point, m.
+  double gone_distance = 0.05;
+
+  /// @throws InvalidArgument naming the first bad field and its value.
+  void Validate() const;
+};
+
+/// A tube a scan shows hanging over a bin wall: its axis reaches the wall's top at the wall. Such
+/// a tube leans on the wall and on what lies under it; when that moves it can fall out of the bin,
+/// where no scan of the bin sees it (in a simulated 20-tree bin, a tree leaning on the -y wall fell
+/// over it when the tree it leaned on was picked).
+struct TubeOverWall {
+  std::uint32_t tube_id = 0;
+  /// The highest such point of its axis, bin frame, m.
+  Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
+  /// "+x", "-x", "+y" or "-y": the wall it hangs over.
+  std::string wall;
+  /// The scan that showed it.
+  std::uint32_t scan = 0;
+};
+
+/// The tubes of `response` that hang over a wall of `bin` (one entry per tube, its highest point).
+std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, const BinConfig& bin,
+                                         std::uint32_t scan, const WallWatchParams& params);
+
+/// Those of `before` that `after` no longer shows (no cylinder axis within gone_distance of their
+/// point) and that no attempt or nudge since took (`touched`: their tube ids in before's scan).
+std::vector<TubeOverWall> VanishedOverWalls(const std::vector<TubeOverWall>& before,
+                                            const v1::PlanPickResponse& after,
+                                            const std::vector<std::uint32_t>& touched,
+                                            const WallWatchParams& params);
+
+/// "over the -y wall at (-0.030, -0.304, 0.220) m, not seen again after scan 5".
+std::string Describe(const TubeOverWall& tube);
+
+}  // namespace tubepick::cell
