@@ -287,14 +287,19 @@ CellController::PlannedScan CellController::ScanBin(RunState& run) {
   PlanPick(capture, scan);
   for (const v1::ModelingWarning& w : scan.response.modeling().warnings())
     ++run.result.planner_warnings[w.code()];
-  WatchWalls(scan, run);
+  WatchWalls(scan, capture, run);
   return scan;
 }
 
-void CellController::WatchWalls(PlannedScan& scan, RunState& run) {
-  for (const TubeOverWall& gone :
-       VanishedOverWalls(run.over_walls, scan.response, run.touched, params_.wall_watch)) {
-    const std::string what = Describe(gone);
+void CellController::WatchWalls(PlannedScan& scan, const devices::Capture& capture, RunState& run) {
+  // After a lift of several tubes, which ones came along is not known (the rotation frees them
+  // over the bin's middle): nothing is said for that scan.
+  const std::vector<TubeOverWall> gone =
+      run.lifted_several
+          ? std::vector<TubeOverWall>{}
+          : VanishedOverWalls(run.over_walls, capture, cell_.bin, run.touched, params_.wall_watch);
+  for (const TubeOverWall& tube : gone) {
+    const std::string what = Describe(tube);
     spdlog::warn(
         "cell: round {} scan {}: a tube hung {} though no attempt took it: it may have fallen out of the "
         "bin (check the floor beside that wall)",
@@ -304,6 +309,7 @@ void CellController::WatchWalls(PlannedScan& scan, RunState& run) {
   }
   run.over_walls = TubesOverWalls(scan.response, cell_.bin, scan.index, params_.wall_watch);
   run.touched.clear();
+  run.lifted_several = false;
 }
 
 void CellController::TakeVanishedOverWalls(PlannedScan& scan, nlohmann::json& record) {
@@ -400,6 +406,8 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   d["attempt_wall_s"] = SecondsSince(attempt.started);
   d["attempt_device_s"] = DeviceNow() - attempt.device_started;
   record["truth_after"] = Truth();
+  if (const auto a = record.find("analysis"); a != record.end() && a->value("outcome", "") == "multiple")
+    run.lifted_several = true;
   CountAttemptWrench(attempt, run.result);
   run.since_pick.push_back(DescribeAttemptBriefly(record));
   RememberFailedGrasp(outcome, attempt, run);

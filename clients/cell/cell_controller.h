@@ -338,9 +338,10 @@ class CellController {
   bool ScanAndPick(RunState& run);
   PlannedScan ScanBin(RunState& run);
   void PlanPick(const devices::Capture& capture, PlannedScan& scan);
-  /// Tubes the last scan showed hanging over a wall that this one does not, though no attempt or
-  /// nudge took them: logged, recorded with the next record and on the round's result.
-  void WatchWalls(PlannedScan& scan, RunState& run);
+  /// Tubes the last scan showed hanging over a wall that this one's cloud does not show, though no
+  /// attempt or nudge took them (nor a lift of several tubes): logged, recorded with the next
+  /// record and on the round's result.
+  void WatchWalls(PlannedScan& scan, const devices::Capture& capture, RunState& run);
   /// Moves the scan's vanished_over_walls into `record` (the first record of the scan).
   static void TakeVanishedOverWalls(PlannedScan& scan, nlohmann::json& record);
   /// The scan's plans in rank order, skipping those that cannot be executed; returns how many ran.

@@ -92,7 +92,8 @@ void DescribeFields(Visit& v, WallWatchParams& w) {
   v("enabled", w.enabled, "warn when a tube seen hanging over a wall is gone at the next scan");
   v("below_top", w.below_top, "m: a tube's axis this close below the wall top or higher ...");
   v("from_wall", w.from_wall, "m: ... and this close to the wall's inner face or past it hangs over it");
-  v("gone_distance", w.gone_distance, "m: gone when no tube axis of the next scan comes this close");
+  v("gone_distance", w.gone_distance, "m: gone when the next scan has fewer than min_points this close");
+  v("min_points", w.min_points, "(the wall's own points left out)");
 }
 
 template <typename Visit>

@@ -131,6 +131,8 @@ struct CellController::RunState {
   /// The last scan's tubes hanging over a wall, and the tubes attempted or nudged since.
   std::vector<TubeOverWall> over_walls;
   std::vector<std::uint32_t> touched;
+  /// An attempt since that scan lifted several tubes (which ones is not known).
+  bool lifted_several = false;
 };
 
 template <typename Body>

@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 
+#include "core/common/errors.h"
 #include "core/common/require.h"
-#include "core/common/segment_geometry.h"
 
 namespace tubepick::cell {
 namespace {
@@ -30,22 +31,13 @@ std::optional<std::string> WallAt(const Eigen::Vector3d& p, const BinConfig& bin
   return std::string(nearest->second);
 }
 
-bool ShownNear(const Eigen::Vector3d& p, const v1::PlanPickResponse& response, double distance) {
-  for (const v1::Tube& tube : response.tubes()) {
-    for (const v1::Cylinder& c : tube.cylinders()) {
-      const Eigen::Vector3d a = Point(c.start());
-      if (ClosestPointsOfSegments(p, p, a, Point(c.end())).distance <= distance) return true;
-    }
-  }
-  return false;
-}
-
 }  // namespace
 
 void WallWatchParams::Validate() const {
   RequireNonNegative(below_top, "wall_watch.below_top");
   RequireNonNegative(from_wall, "wall_watch.from_wall");
   RequirePositive(gone_distance, "wall_watch.gone_distance");
+  if (min_points == 0) throw InvalidArgument("wall_watch.min_points: must be at least 1, got 0");
 }
 
 std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, const BinConfig& bin,
@@ -66,14 +58,34 @@ std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, c
   return out;
 }
 
+std::size_t PointsNear(const devices::Capture& capture, const Eigen::Vector3d& p_Bin, double distance,
+                       const BinConfig& bin) {
+  // Compared in the capture's frame and unit: a rigid transform keeps distances.
+  const double scale = capture.unit == LengthUnit::kMillimetre ? 1000.0 : 1.0;
+  const Eigen::Vector3f p = (scale * (capture.X_BinSensor.inverse() * p_Bin)).cast<float>();
+  const float r2 = static_cast<float>(scale * distance * scale * distance);
+  constexpr double kWallBand = 0.005;
+  const Eigen::Vector3d half = 0.5 * bin.inner_size;
+  std::size_t n = 0;
+  for (const Eigen::Vector3f& q : capture.points_Sensor) {
+    if ((q - p).squaredNorm() > r2) continue;
+    const Eigen::Vector3d q_Bin = capture.X_BinSensor * (q.cast<double>() / scale);
+    const bool at_wall =
+        q_Bin.z() <= bin.inner_size.z() + kWallBand &&
+        (std::abs(q_Bin.x()) >= half.x() - kWallBand || std::abs(q_Bin.y()) >= half.y() - kWallBand);
+    if (!at_wall) ++n;
+  }
+  return n;
+}
+
 std::vector<TubeOverWall> VanishedOverWalls(const std::vector<TubeOverWall>& before,
-                                            const v1::PlanPickResponse& after,
+                                            const devices::Capture& after, const BinConfig& bin,
                                             const std::vector<std::uint32_t>& touched,
                                             const WallWatchParams& params) {
   std::vector<TubeOverWall> out;
   for (const TubeOverWall& tube : before) {
     if (std::find(touched.begin(), touched.end(), tube.tube_id) != touched.end()) continue;
-    if (!ShownNear(tube.p_Bin, after, params.gone_distance)) out.push_back(tube);
+    if (PointsNear(after, tube.p_Bin, params.gone_distance, bin) < params.min_points) out.push_back(tube);
   }
   return out;
 }

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "core/common/cell_config.h"
+#include "devices/scanner.h"
 #include "tubepick/v1/planning.pb.h"
 
 namespace tubepick::cell {
@@ -17,11 +18,16 @@ struct WallWatchParams {
   bool enabled = true;
   /// A tube hangs over a wall where a point of its axis lies no lower than this below the wall top,
   /// m, ...
-  double below_top = 0.03;
-  /// ... and no farther than this inside the wall's inner face (or past it), m.
-  double from_wall = 0.03;
-  /// Gone when no axis of the next scan's tubes comes within this of that point, m.
-  double gone_distance = 0.05;
+  double below_top = 0.0;
+  /// ... and no farther than this inside the wall's inner face (or past it), m. With 3 cm each, in
+  /// five simulated 20-tree bins two tubes leaning on a wall's inner face slid away unseen after a
+  /// pick (the warning said they might have fallen out); at 0 neither counted, and the tree that did
+  /// fall out of another bin did.
+  double from_wall = 0.0;
+  /// Gone when the next scan has fewer than `min_points` points within this of that point, m,
+  /// leaving out the wall's own (its inner face and its top).
+  double gone_distance = 0.03;
+  std::uint32_t min_points = 20;
 
   /// @throws InvalidArgument naming the first bad field and its value.
   void Validate() const;
@@ -45,10 +51,17 @@ struct TubeOverWall {
 std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, const BinConfig& bin,
                                          std::uint32_t scan, const WallWatchParams& params);
 
-/// Those of `before` that `after` no longer shows (no cylinder axis within gone_distance of their
-/// point) and that no attempt or nudge since took (`touched`: their tube ids in before's scan).
+/// Points of `capture` within `distance` of p_Bin, leaving out the walls of `bin` (points at or
+/// below the wall top within 5 mm of an inner face, or past it).
+std::size_t PointsNear(const devices::Capture& capture, const Eigen::Vector3d& p_Bin, double distance,
+                       const BinConfig& bin);
+
+/// Those of `before` that the next scan, `after`, no longer shows (fewer than min_points points
+/// within gone_distance of their point: the cloud, not the next model, which may split or renumber
+/// a tube that is still there) and that no attempt or nudge since took (`touched`: their tube ids
+/// in before's scan).
 std::vector<TubeOverWall> VanishedOverWalls(const std::vector<TubeOverWall>& before,
-                                            const v1::PlanPickResponse& after,
+                                            const devices::Capture& after, const BinConfig& bin,
                                             const std::vector<std::uint32_t>& touched,
                                             const WallWatchParams& params);
 

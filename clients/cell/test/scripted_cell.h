@@ -41,6 +41,8 @@ class ScriptedScanner final : public devices::Scanner {
   std::vector<std::optional<Failure>> failures;
   /// Calls (0-based) that return no point.
   std::vector<int> empty_at;
+  /// Further points every capture holds, bin frame (a tube that stays where it is).
+  std::vector<Eigen::Vector3d> points_Bin;
   int calls = 0;
 
   devices::Capture Scan(devices::Timeout) override {
@@ -49,6 +51,8 @@ class ScriptedScanner final : public devices::Scanner {
     devices::Capture c;
     if (std::find(empty_at.begin(), empty_at.end(), i) != empty_at.end()) return c;
     c.points_Sensor = {Eigen::Vector3f(0.f, 0.f, 1.f), Eigen::Vector3f(0.01f, 0.f, 1.f)};
+    for (const Eigen::Vector3d& p : points_Bin)
+      c.points_Sensor.push_back((c.X_BinSensor.inverse() * p).cast<float>());
     return c;
   }
 };
