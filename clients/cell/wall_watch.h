@@ -20,9 +20,9 @@ struct WallWatchParams {
   /// m, ...
   double below_top = 0.0;
   /// ... and no farther than this inside the wall's inner face (or past it), m. With 3 cm each, in
-  /// five simulated 20-tree bins two tubes leaning on a wall's inner face slid away unseen after a
-  /// pick (the warning said they might have fallen out); at 0 neither counted, and the tree that did
-  /// fall out of another bin did.
+  /// ten simulated 20-tree bins two tubes leaning on a wall's inner face slid away unseen after a
+  /// pick (the warning said they might have fallen out); at 0 neither counted, and the one tree that
+  /// did fall out did (docs/ACCURACY.md, "Hard bins").
   double from_wall = 0.0;
   /// Gone when the next scan has fewer than `min_points` points within this of that point, m,
   /// leaving out the wall's own (its inner face and its top).
