@@ -1581,15 +1581,22 @@ TEST_F(CellControllerTest, StopWhileHoldingATubeReleasesItOverTheBin) {
 
 // ---------------------------------------------------------------- a tube over a wall
 
-TEST_F(CellControllerTest, ATubeOverAWallThatTheNextScanNoLongerShowsIsNamedOnTheRound) {
-  // Scan 0: tube 4 is picked; tube 7 leans on the -y wall, over its top. Scan 1: only tube 9, far
-  // from where tube 7 hung; it is picked. Scan 2: empty.
-  auto first = Plans({MakePlan(4, p_Bin_grasp)}, 0);
-  AddTubeAxis(first.response, 4, {{0.05, -0.05, 0.03}, {0.15, -0.05, 0.03}});
-  AddTubeAxis(first.response, 7, {{-0.08, -0.10, 0.11}, {-0.029, -0.304, 0.22}});
-  auto second = Plans({MakePlan(9, GraspSpot(3))}, 0);
-  AddTubeAxis(second.response, 9, {{0.0, 0.1, 0.03}, {0.1, 0.1, 0.03}});
-  planner.plan_answers = {first, second};
+class WallWatchTest : public CellControllerTest {
+ protected:
+  /// Scan 0 plans tube 4; tube 7 leans on the -y wall, over its top. Scan 1 models only tube 9,
+  /// far from where tube 7 hung, and plans it. Scan 2: empty.
+  void ScriptATubeOverAWallThenAnotherScan() {
+    auto first = Plans({MakePlan(4, p_Bin_grasp)}, 0);
+    AddTubeAxis(first.response, 4, {{0.05, -0.05, 0.03}, {0.15, -0.05, 0.03}});
+    AddTubeAxis(first.response, 7, {{-0.08, -0.10, 0.11}, {-0.029, -0.304, 0.22}});
+    auto second = Plans({MakePlan(9, GraspSpot(3))}, 0);
+    AddTubeAxis(second.response, 9, {{0.0, 0.1, 0.03}, {0.1, 0.1, 0.03}});
+    planner.plan_answers = {first, second};
+  }
+};
+
+TEST_F(WallWatchTest, ATubeOverAWallThatTheNextScanNoLongerShowsIsNamedOnTheRound) {
+  ScriptATubeOverAWallThenAnotherScan();  // nothing in the captures where tube 7 hung
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
@@ -1605,15 +1612,10 @@ TEST_F(CellControllerTest, ATubeOverAWallThatTheNextScanNoLongerShowsIsNamedOnTh
   EXPECT_EQ(attempts[1]["vanished_over_walls"].size(), 1u);
 }
 
-TEST_F(CellControllerTest, ATubeOverAWallThatTheNextCloudStillShowsIsNotMissedThoughTheModelDropsIt) {
-  // As above, but the tube over the wall is still in every capture; scan 1's model lost it.
+TEST_F(WallWatchTest, ATubeOverAWallThatTheNextCloudStillShowsIsNotMissedThoughTheModelDropsIt) {
+  // The tube over the wall is still in every capture; scan 1's model lost it.
   for (int i = 0; i < 30; ++i) scanner.points_Bin.push_back({-0.04 + 0.001 * i, -0.295, 0.225});
-  auto first = Plans({MakePlan(4, p_Bin_grasp)}, 0);
-  AddTubeAxis(first.response, 4, {{0.05, -0.05, 0.03}, {0.15, -0.05, 0.03}});
-  AddTubeAxis(first.response, 7, {{-0.08, -0.10, 0.11}, {-0.029, -0.304, 0.22}});
-  auto second = Plans({MakePlan(9, GraspSpot(3))}, 0);
-  AddTubeAxis(second.response, 9, {{0.0, 0.1, 0.03}, {0.1, 0.1, 0.03}});
-  planner.plan_answers = {first, second};
+  ScriptATubeOverAWallThenAnotherScan();
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
@@ -1621,22 +1623,17 @@ TEST_F(CellControllerTest, ATubeOverAWallThatTheNextCloudStillShowsIsNotMissedTh
   EXPECT_TRUE(result.vanished_over_walls.empty());
 }
 
-TEST_F(CellControllerTest, ATubeOverAWallIsNotMissedAfterALiftOfSeveralTubes) {
+TEST_F(WallWatchTest, ATubeOverAWallIsNotMissedAfterALiftOfSeveralTubes) {
   // The first lift holds two tubes and is put back: the one over the wall may have come along.
   params.max_plans_per_scan = 1;
-  auto first = Plans({MakePlan(4, p_Bin_grasp)}, 0);
-  AddTubeAxis(first.response, 4, {{0.05, -0.05, 0.03}, {0.15, -0.05, 0.03}});
-  AddTubeAxis(first.response, 7, {{-0.08, -0.10, 0.11}, {-0.029, -0.304, 0.22}});
-  auto second = Plans({MakePlan(9, GraspSpot(3))}, 0);
-  AddTubeAxis(second.response, 9, {{0.0, 0.1, 0.03}, {0.1, 0.1, 0.03}});
-  planner.plan_answers = {first, second};
+  ScriptATubeOverAWallThenAnotherScan();
   planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
   const CellRunResult result = Run();
   EXPECT_EQ(Records("attempt").at(0)["analysis"]["outcome"], "multiple");
   EXPECT_TRUE(result.vanished_over_walls.empty());
 }
 
-TEST_F(CellControllerTest, ATubeOverAWallThatAnAttemptTookIsNotMissed) {
+TEST_F(WallWatchTest, ATubeOverAWallThatAnAttemptTookIsNotMissed) {
   // Along x over the +x wall, grasped at its middle: the place lays it on the place frame (the
   // cell check).
   auto first = Plans({MakePlan(7, {0.205, 0.0, 0.19})}, 0);
