@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
@@ -242,8 +241,8 @@ std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOu
 }
 
 /// Several tubes: carried over the bin's middle (resolution_hold_over_bin), then the resolution
-/// motions in order there, each followed by a new reading at the hold pose; unresolved, put back
-/// there.
+/// motions in order there, each followed by a new reading at the hold pose; unresolved, back to the
+/// lift pose and put back.
 CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchResponse& analysis,
                                                       const devices::WrenchReading& reference,
                                                       const devices::WrenchReading& lifted,
@@ -273,7 +272,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
             Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))
       return *result;
   }
-  PutBack(poses.X_BinTcpGrasp, X_BinTcpHold, reference, attempt);
+  if (!shift_Bin.isZero()) MoveTo(X_BinTcpLift, params_.lift_speed, &attempt);
+  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, reference, attempt);
   return AttemptResult::kMultipleReturned;
 }
 
@@ -427,51 +427,22 @@ void CellController::ReleaseEmpty(Attempt& attempt) {
   GoHome(&attempt);
 }
 
-void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpHold,
+void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
                              const devices::WrenchReading& reference, Attempt& attempt) {
   Enter(CellState::kReturnToBin);
-  // Where the resolution held them: their centre of mass over the bin's middle (the lift pose
-  // without the hold), not back at the lift pose, where it may hang at a wall. Down in steps to
-  // where they rest, at the lowest release_height above the grasp height.
-  Eigen::Isometry3d X_BinTcpLowest = X_BinTcpHold;
-  X_BinTcpLowest.translation().z() =
-      std::min(X_BinTcpHold.translation().z(), X_BinTcpGrasp.translation().z() + params_.release_height);
-  const Eigen::Isometry3d X_BinTcpOpen = LowerOntoHeap(X_BinTcpHold, X_BinTcpLowest, attempt);
+  // Straight down from the lift pose (its xy was checked against the bin's safety zone by the
+  // planner) to just above the grasp height, open, and back up.
+  const double drop =
+      X_BinTcpGrasp.translation().z() + params_.release_height - X_BinTcpLift.translation().z();
+  if (drop < 0.0)
+    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, drop)}, params_.lift_speed, &attempt);
   OpenGripper();
-  MoveTo(X_BinTcpHold, params_.approach_speed, &attempt);
-  CheckToolEmpty(reference, "after_put_back", X_BinTcpOpen, attempt);
+  if (drop < 0.0)
+    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -drop)}, params_.approach_speed, &attempt);
+  Eigen::Isometry3d X_BinTcpReleased = X_BinTcpLift;
+  X_BinTcpReleased.translation().z() += std::min(drop, 0.0);
+  CheckToolEmpty(reference, "after_put_back", X_BinTcpReleased, attempt);
   GoHome(&attempt);
-}
-
-Eigen::Isometry3d CellController::LowerOntoHeap(const Eigen::Isometry3d& X_BinTcpFrom,
-                                                const Eigen::Isometry3d& X_BinTcpTo, Attempt& attempt) {
-  const std::vector<Eigen::Isometry3d> steps = DescentSteps(params_.put_back_step, X_BinTcpFrom, X_BinTcpTo);
-  if (!steps.empty()) {
-    const devices::WrenchReading held = ReadWrench();
-    for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
-      MoveTo(X_BinTcpStep, params_.approach_speed, &attempt);
-      double change = 0.0;
-      try {
-        change = (ReadWrench().force - held.force).norm();
-      } catch (const CellFault& fault) {
-        // Readings that keep disagreeing one step lower than a steady one: pressing on the heap.
-        if (fault.device() != "ft_sensor" || fault.kind() != FaultKind::kDeviceFault) throw;
-        change = std::numeric_limits<double>::infinity();
-      }
-      if (change > HeapContactLoad()) {
-        attempt.record["put_back_rest"] = X_BinTcpFrom.translation().z() - X_BinTcpStep.translation().z();
-        return X_BinTcpStep;
-      }
-    }
-  }
-  MoveTo(X_BinTcpTo, params_.approach_speed, &attempt);
-  return X_BinTcpTo;
-}
-
-double CellController::HeapContactLoad() const {
-  // Half a tube's weight: held tubes resting on the heap lighten the load by about a tube's weight
-  // (or more, the tool pressing); a swing after a step does not.
-  return 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
 }
 
 void CellController::CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,

@@ -448,18 +448,9 @@ class CellController {
   /// The tube is gone: record where and when, open (the fingers closed on nothing), home.
   void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);
-  /// Several tubes held after every resolution motion: from the hold pose (X_BinTcpHold) down into
-  /// the bin in F/T-read steps (LowerOntoHeap), open where they rest, back up.
-  void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpHold,
+  /// Several tubes held after every resolution motion: lower them back into the bin and open.
+  void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
                const devices::WrenchReading& reference, Attempt& attempt);
-  /// From X_BinTcpFrom straight down to X_BinTcpTo in put_back_step steps, reading the F/T after
-  /// each: the first step where the held load differs from its reading at X_BinTcpFrom by more than
-  /// HeapContactLoad, or the readings disagree (recorded as record["put_back_rest"], metres below
-  /// X_BinTcpFrom), else X_BinTcpTo once there. Other F/T faults are thrown.
-  Eigen::Isometry3d LowerOntoHeap(const Eigen::Isometry3d& X_BinTcpFrom, const Eigen::Isometry3d& X_BinTcpTo,
-                                  Attempt& attempt);
-  /// Half a tube's weight, N: a held load that changes by more rests on something.
-  double HeapContactLoad() const;
   /// Before the tool goes home empty-handed (after a failed grasp, a put-back, a nudge, the place):
   /// a reading against `reference` (the same gripper opening and, but for a turn about the
   /// vertical, orientation) that must weigh nothing, into record["wrench"][key]. A tube caught on

@@ -119,9 +119,7 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("resolution_wall_margin", p.resolution_wall_margin, "m, the TCP inside the bin walls while it does");
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
-  v("release_height", p.release_height, "m above the grasp: the lowest a put-back of several tubes goes");
-  v("put_back_step", p.put_back_step,
-    "m: down to it in steps from where the resolution held them, opening where they rest; 0 = one move");
+  v("release_height", p.release_height, "m above the grasp to put back several tubes");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
   v("place_recheck_height", p.place_recheck_height, "m higher again when the load there is light");
   v("place_step", p.place_step,

@@ -57,7 +57,6 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
   RequireNonNegativeValue(place_step, "place_step");
   RequireNonNegativeValue(safe_release_step, "safe_release_step");
-  RequireNonNegativeValue(put_back_step, "put_back_step");
   RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())
     throw InvalidArgument("cell controller home_pose_in_bin (X_BinHome): not finite");

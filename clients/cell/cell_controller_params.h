@@ -53,14 +53,9 @@ struct CellControllerParams {
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.
   double transit_clearance = 0.30;
-  /// Several tubes that the resolution could not shake off are put back where the resolution held
-  /// them (over the bin's middle with resolution_hold_over_bin, else at the lift pose), lowered in
-  /// steps of at most put_back_step reading the F/T after each, and let go where they rest on the
-  /// heap (the load changes by half a tube's weight, or the readings disagree) or, at the lowest,
-  /// this height above the grasp point, metres. Put back at the lift pose instead, two trees of a
-  /// simulated 20-tree bin whose centre of mass hung at the +x wall ended outside the bin.
+  /// Several tubes that the resolution could not shake off are lowered back to this height above
+  /// the grasp point before the gripper opens, metres.
   double release_height = 0.03;
-  double put_back_step = 0.03;
   /// Safe stop while holding a tube: the TCP goes over the bin's middle and down to this height
   /// above the bin floor before the gripper opens (below the wall top: the tube falls inside),
   /// metres.

@@ -13,6 +13,7 @@
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
+#include "clients/cell/local_wrench_analysis.h"
 
 namespace tubepick::cell {
 namespace {
@@ -111,7 +112,9 @@ Eigen::Isometry3d CellController::DescendIntoBin(const Eigen::Isometry3d& X_BinT
       DescentSteps(params_.safe_release_step, X_BinTcpAbove, X_BinTcpRelease);
   std::optional<devices::WrenchReading> over_bin;
   if (!steps.empty()) over_bin = SafeStopReading(rest);
-  const double contact = HeapContactLoad();
+  // Half a tube's weight: the held tube resting on the heap lightens the load by about its weight
+  // (or more, the tool pressing); a swing after a step does not.
+  const double contact = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
   for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
     if (!over_bin) break;
     devices_.robot->MoveTo(X_BinTcpStep, params_.approach_speed, params_.robot_timeout);

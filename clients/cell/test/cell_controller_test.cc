@@ -560,53 +560,21 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(result.picks, 0u);
   EXPECT_EQ(result.scans, 2u);
   EXPECT_EQ(planner.wrench_requests.size(), 3u);
-  // Put back where the resolution held them (the payload over the bin's middle), lowered in steps
-  // to release_height above the grasp height, opened there, back up; never back at the lift pose.
-  const json a = Records("attempt").at(0);
-  const Eigen::Vector3d shift(a["resolution"]["hold_shift"][0].get<double>(),
-                              a["resolution"]["hold_shift"][1].get<double>(), 0.0);
-  ASSERT_GT(shift.norm(), 0.05);
-  ASSERT_GE(gripper.opened_at.size(), 2u);
-  EXPECT_TRUE(gripper.opened_at.back().isApprox(
-      p_Bin_grasp + shift + Eigen::Vector3d(0, 0, params.release_height), kTol));
-  const auto lift_index = std::find_if(robot.moves.begin(), robot.moves.end(), [&](const auto& m) {
-    return m.X_BinTcpTarget.isApprox(X_BinTcpLift, kTol);
-  });
-  ASSERT_NE(lift_index, robot.moves.end());
-  EXPECT_EQ(std::count_if(robot.moves.begin(), robot.moves.end(),
-                          [&](const auto& m) { return m.X_BinTcpTarget.isApprox(X_BinTcpLift, kTol); }),
-            1)
-      << "the lift pose is visited once, at the lift";
-  EXPECT_FALSE(a.contains("put_back_rest"));
+  // Lowered straight down to release_height above the grasp point, opened, back up.
+  bool lowered = false;
+  for (const testing::ScriptedRobot::Move& m : robot.moves)
+    if (m.through &&
+        m.X_BinTcpTarget.isApprox(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height)), kTol))
+      lowered = true;
+  EXPECT_TRUE(lowered);
   EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   EXPECT_TRUE(gripper.open);
 
+  const json a = Records("attempt").at(0);
   EXPECT_EQ(a["resolution"]["used"], 2);
   EXPECT_EQ(a["resolution"]["succeeded"], false);
   EXPECT_EQ(a["wrench"]["after_resolution"].size(), 2u);
   EXPECT_EQ(a["result"], "multiple_returned");
-}
-
-TEST_F(CellControllerTest, SeveralTubesPutBackAreLetGoWhereTheyRestOnTheHeap) {
-  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
-  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
-  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 1);
-  AddWaypoint(multiple, 0, X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
-  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0)};
-  // The hold pose is 0.43 m high; the heap takes the load from 0.35 m down (the third 3 cm step).
-  ft.tcp = &robot.X_BinTcp;
-  ft.rests_below_z = 0.35;
-  const CellRunResult result = Run();
-  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
-  const json a = Records("attempt").at(0);
-  EXPECT_EQ(a["result"], "multiple_returned");
-  ASSERT_GE(gripper.opened_at.size(), 2u);
-  const double hold_z = X_BinTcpLift.translation().z();
-  const double step =
-      (hold_z - p_Bin_grasp.z() - params.release_height) /
-      std::ceil((hold_z - p_Bin_grasp.z() - params.release_height) / params.put_back_step - 1e-9);
-  EXPECT_NEAR(gripper.opened_at.back().z(), hold_z - 3 * step, kTol);
-  EXPECT_NEAR(a["put_back_rest"].get<double>(), 3 * step, kTol);
 }
 
 TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {
