@@ -229,8 +229,8 @@ void WriteText(const std::filesystem::path& path, const std::string& text) {
 TEST(CellCliTest, TheShippedControllerExampleIsWhatTheCommandPrints) {
   const testing::CliRun run = RunCli("cell --print-controller-config");
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_EQ(run.output,
-            testing::ReadText(std::filesystem::path(TUBEPICK_SOURCE_DIR) / "deploy" / "cell-controller.example.yaml"))
+  EXPECT_EQ(run.output, testing::ReadText(std::filesystem::path(TUBEPICK_SOURCE_DIR) / "deploy" /
+                                          "cell-controller.example.yaml"))
       << "regenerate deploy/cell-controller.example.yaml with `tubepick cell --print-controller-config`";
 }
 

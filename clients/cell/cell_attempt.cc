@@ -392,7 +392,7 @@ std::optional<bool> CellController::LoadBeforePlaceUnlessPressing(const devices:
   try {
     return LoadBeforePlace(reference, key, attempt, check);
   } catch (const CellFault& fault) {
-    if (fault.device() != "ft_sensor" || fault.kind() != FaultKind::kDeviceFault) throw;
+    if (!detail::ReadingsDisagree(fault)) throw;
     attempt.record["wrench"][std::string(key) + "_unsettled"] = fault.error();
     spdlog::warn("cell: round {}: over the place pose ({}): {}", round_, key, fault.error());
     return std::nullopt;

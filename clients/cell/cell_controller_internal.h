@@ -68,6 +68,12 @@ constexpr double kSameHeight = 1e-4;  // m: moves shorter than this are skipped
 /// The "no_plan" record's cell_mismatch: every one of `plans` skipped as not fitting the cell.
 std::string CellMismatchMessage(std::uint32_t plans, const std::string& first_reason);
 
+/// An F/T measurement whose readings kept disagreeing (ReadWrench's ft_sensor device_fault): the
+/// held tube pressing on something, where the place and the safe stop expect it to.
+inline bool ReadingsDisagree(const CellFault& fault) {
+  return fault.device() == "ft_sensor" && fault.kind() == FaultKind::kDeviceFault;
+}
+
 }  // namespace detail
 
 /// One picking attempt (or nudge) under way: its record and its running durations.

@@ -110,25 +110,26 @@ Eigen::Isometry3d CellController::DescendIntoBin(const Eigen::Isometry3d& X_BinT
   const Eigen::Isometry3d X_BinTcpAbove = WithHeight(X_BinTcpRelease, TransitHeight(params_, cell_));
   const std::vector<Eigen::Isometry3d> steps =
       DescentSteps(params_.safe_release_step, X_BinTcpAbove, X_BinTcpRelease);
-  std::optional<devices::WrenchReading> over_bin;
-  if (!steps.empty()) over_bin = SafeStopReading(rest);
+  // No steps, or no reading over the bin to compare with: straight down.
+  const std::optional<devices::WrenchReading> over_bin = steps.empty() ? std::nullopt : SafeStopReading(rest);
   // Half a tube's weight: the held tube resting on the heap lightens the load by about its weight
   // (or more, the tool pressing); a swing after a step does not.
   const double contact = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
-  for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
-    if (!over_bin) break;
-    devices_.robot->MoveTo(X_BinTcpStep, params_.approach_speed, params_.robot_timeout);
-    bool pressing = false;
-    const std::optional<devices::WrenchReading> now = SafeStopReading(rest, &pressing);
-    const double change = now ? (now->force - over_bin->force).norm() : 0.0;
-    if (pressing || change > contact) {
-      *rest = pressing ? ", where the F/T readings started to disagree (resting on the heap)"
-                       : fmt::format(", where it rests on the heap (the load changed by {:.2f} N)", change);
-      spdlog::warn("cell: safe stop: the held tube rests on the heap at X_BinTcp z {:.3f} m: opening there",
-                   X_BinTcpStep.translation().z());
-      return X_BinTcpStep;
+  if (over_bin) {
+    for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
+      devices_.robot->MoveTo(X_BinTcpStep, params_.approach_speed, params_.robot_timeout);
+      bool pressing = false;
+      const std::optional<devices::WrenchReading> now = SafeStopReading(rest, &pressing);
+      const double change = now ? (now->force - over_bin->force).norm() : 0.0;
+      if (pressing || change > contact) {
+        *rest = pressing ? ", where the F/T readings started to disagree (resting on the heap)"
+                         : fmt::format(", where it rests on the heap (the load changed by {:.2f} N)", change);
+        spdlog::warn("cell: safe stop: the held tube rests on the heap at X_BinTcp z {:.3f} m: opening there",
+                     X_BinTcpStep.translation().z());
+        return X_BinTcpStep;
+      }
+      if (!now) break;
     }
-    if (!now) break;
   }
   devices_.robot->MoveTo(X_BinTcpRelease, params_.approach_speed, params_.robot_timeout);
   return X_BinTcpRelease;
@@ -138,7 +139,7 @@ std::optional<devices::WrenchReading> CellController::SafeStopReading(std::strin
   try {
     return ReadWrench();
   } catch (const CellFault& fault) {
-    if (pressing && fault.device() == "ft_sensor" && fault.kind() == FaultKind::kDeviceFault) {
+    if (pressing && detail::ReadingsDisagree(fault)) {
       *pressing = true;  // readings that keep disagreeing below a steady one: pressing on the heap
       return std::nullopt;
     }

@@ -9,11 +9,10 @@
 
 #include "core/common/errors.h"
 #include "core/common/require.h"
+#include "wire/proto_convert.h"
 
 namespace tubepick::cell {
 namespace {
-
-Eigen::Vector3d Point(const v1::Vector3& v) { return {v.x(), v.y(), v.z()}; }
 
 /// The wall `p` hangs over, or nullopt.
 std::optional<std::string> WallAt(const Eigen::Vector3d& p, const BinConfig& bin,
@@ -47,7 +46,7 @@ std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, c
   for (const v1::Tube& tube : response.tubes()) {
     std::optional<TubeOverWall> highest;
     for (const v1::Cylinder& c : tube.cylinders()) {
-      for (const Eigen::Vector3d& p : {Point(c.start()), Point(c.end())}) {
+      for (const Eigen::Vector3d& p : {FromProto(c.start()), FromProto(c.end())}) {
         const std::optional<std::string> wall = WallAt(p, bin, params);
         if (!wall || (highest && highest->p_Bin.z() >= p.z())) continue;
         highest = TubeOverWall{tube.id(), p, *wall, scan};

@@ -274,6 +274,20 @@ TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
             std::string::npos)
       << ParseError("place_step: -0.02\n");
   EXPECT_EQ(ParseCellControllerParams("place_step: 0.01\n").place_step, 0.01);
+  EXPECT_NE(ParseError("safe_release_step: -0.03\n")
+                .find("safe_release_step: must be a non-negative number, got -0.03"),
+            std::string::npos)
+      << ParseError("safe_release_step: -0.03\n");
+  EXPECT_EQ(ParseCellControllerParams("safe_release_step: 0.05\n").safe_release_step, 0.05);
+  EXPECT_NE(ParseError("wall_watch:\n  gone_distance: 0\n").find("wall_watch.gone_distance"),
+            std::string::npos)
+      << ParseError("wall_watch:\n  gone_distance: 0\n");
+  EXPECT_NE(
+      ParseError("wall_watch:\n  min_points: 0\n").find("wall_watch.min_points: must be at least 1, got 0"),
+      std::string::npos)
+      << ParseError("wall_watch:\n  min_points: 0\n");
+  EXPECT_NE(ParseError("wall_watch:\n  from_wall: -0.01\n").find("wall_watch.from_wall"), std::string::npos);
+  EXPECT_EQ(ParseCellControllerParams("wall_watch:\n  from_wall: 0.03\n").wall_watch.from_wall, 0.03);
 }
 
 TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {

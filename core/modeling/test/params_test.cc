@@ -54,6 +54,8 @@ TEST(Params, TheResolutionRotatesTheThesis45DegreesOr55InTheFastProfileThenAbout
   EXPECT_NEAR(ProfileParams("fast").wrench.rotation_angle, 55.0 * M_PI / 180.0, 1e-15);
   EXPECT_EQ(ProfileParams("thesis").wrench.variant, ResolutionVariant::kTorqueAxis);  // §5.2.6
   EXPECT_EQ(ProfileParams("fast").wrench.variant, ResolutionVariant::kTorqueAxisThenPerpendicular);
+  EXPECT_EQ(ProfileParams("thesis").wrench.force_tolerance_share, 0.0);  // Algorithm 3's F_tol alone
+  EXPECT_EQ(ProfileParams("fast").wrench.force_tolerance_share, 0.2);
 }
 
 TEST(Params, DumpRoundTrips) {
@@ -101,6 +103,13 @@ TEST(Params, OutOfRangeValuesNameTheKey) {
               HasSubstr("modeling.joining.strategy"));
   EXPECT_THAT(ErrorOf("modeling:\n  normals:\n    radius: abc\n"), HasSubstr("expected a number"));
   EXPECT_THAT(ErrorOf("modeling:\n  filters:\n    - random_sample: {count: 0}\n"), HasSubstr("count"));
+}
+
+TEST(Params, AForceToleranceShareOutOfRangeNamesTheKey) {
+  EXPECT_THAT(ErrorOf("wrench:\n  force_tolerance_share: 1.5\n"),
+              HasSubstr("wrench.force_tolerance_share: 1.5 is out of range [0, 1)"));
+  EXPECT_EQ(ParseParams("wrench:\n  force_tolerance_share: 0.1\n", Params{}).wrench.force_tolerance_share,
+            0.1);
 }
 
 TEST(Params, PlanningWrenchAndPlacementSectionsAreStrict) {
