@@ -263,25 +263,47 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   const Eigen::Translation3d shift(shift_Bin);
   const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
+  devices::WrenchReading held = lifted;
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
     resolution["used"] = m + 1;
     const v1::AnalyzeWrenchResponse again =
-        ResolutionMotion(analysis.resolution_motions(m), m, reference, shift, X_BinTcpHold, attempt);
+        ResolutionMotion(analysis.resolution_motions(m), m, reference, shift, X_BinTcpHold, attempt, &held);
     if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
             Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))
       return *result;
   }
-  if (!shift_Bin.isZero()) MoveTo(X_BinTcpLift, params_.lift_speed, &attempt);
-  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, reference, attempt);
+  const Eigen::Isometry3d X_BinTcpPutBack = PutBackPose(reference, held, X_BinTcpLift, attempt);
+  if (!X_BinTcpPutBack.isApprox(X_BinTcpHold)) MoveTo(X_BinTcpPutBack, params_.lift_speed, &attempt);
+  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, X_BinTcpPutBack, reference, attempt);
   return AttemptResult::kMultipleReturned;
+}
+
+Eigen::Isometry3d CellController::PutBackPose(const devices::WrenchReading& reference,
+                                              const devices::WrenchReading& held,
+                                              const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) const {
+  const Payload payload =
+      PayloadOnTool(devices::AsWrench(reference), devices::AsWrench(held), X_BinTcpLift.linear());
+  const Eigen::Vector3d shift_Bin = PlanPutBackShift(X_BinTcpLift.translation(), payload.p_TcpPayload_Bin,
+                                                     cell_.bin.inner_size, params_.put_back_margin);
+  nlohmann::json& resolution = attempt.record["resolution"];
+  resolution["put_back_payload_offset"] = {payload.p_TcpPayload_Bin.x(), payload.p_TcpPayload_Bin.y()};
+  resolution["put_back_shift"] = {shift_Bin.x(), shift_Bin.y()};
+  if (!shift_Bin.isZero()) {
+    const Eigen::Vector3d p_Bin_payload = X_BinTcpLift.translation() + payload.p_TcpPayload_Bin;
+    spdlog::info(
+        "cell: round {}: the tubes not freed hang with their centre of mass at ({:.3f}, {:.3f}) m, less than "
+        "{:.2f} m inside a wall: put back {:.3f} m further inside",
+        round_, p_Bin_payload.x(), p_Bin_payload.y(), params_.put_back_margin, shift_Bin.norm());
+  }
+  return Eigen::Translation3d(shift_Bin) * X_BinTcpLift;
 }
 
 v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                                            const devices::WrenchReading& reference,
                                                            const Eigen::Translation3d& shift,
                                                            const Eigen::Isometry3d& X_BinTcpHold,
-                                                           Attempt& attempt) {
+                                                           Attempt& attempt, devices::WrenchReading* after) {
   // The planner's waypoints turn about the TCP at the lift pose; the same turns about the TCP at
   // the hold pose are the waypoints moved by the hold's shift.
   for (int w = 0; w < motion.waypoints_size(); ++w) {
@@ -292,9 +314,9 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
   }
   MoveTo(X_BinTcpHold, params_.resolution_speed, &attempt);
   CheckStillHolding("resolve", attempt);
-  const devices::WrenchReading after = ReadWrench();
-  const v1::AnalyzeWrenchResponse again = Analyze(reference, after, X_BinTcpHold, attempt);
-  attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, after, again));
+  *after = ReadWrench();
+  const v1::AnalyzeWrenchResponse again = Analyze(reference, *after, X_BinTcpHold, attempt);
+  attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, *after, again));
   return again;
 }
 
@@ -428,21 +450,59 @@ void CellController::ReleaseEmpty(Attempt& attempt) {
 }
 
 void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
+                             const Eigen::Isometry3d& X_BinTcpPutBack,
                              const devices::WrenchReading& reference, Attempt& attempt) {
   Enter(CellState::kReturnToBin);
-  // Straight down from the lift pose (its xy was checked against the bin's safety zone by the
-  // planner) to just above the grasp height, open, and back up.
-  const double drop =
-      X_BinTcpGrasp.translation().z() + params_.release_height - X_BinTcpLift.translation().z();
-  if (drop < 0.0)
+  // Down to just above the grasp height, open, and back up. At the lift pose (its xy checked against
+  // the bin's safety zone by the planner) the tubes go down the way they came up, in one move;
+  // further inside, the heap under them is unknown: in F/T-read steps (LayDown).
+  Eigen::Isometry3d X_BinTcpRelease = X_BinTcpPutBack;
+  X_BinTcpRelease.translation().z() =
+      std::min(X_BinTcpPutBack.translation().z(), X_BinTcpGrasp.translation().z() + params_.release_height);
+  const bool moved_inward = !X_BinTcpPutBack.translation().isApprox(X_BinTcpLift.translation(), 1e-9);
+  const double drop = X_BinTcpRelease.translation().z() - X_BinTcpPutBack.translation().z();
+  Eigen::Isometry3d X_BinTcpOpen = X_BinTcpRelease;
+  if (moved_inward) {
+    X_BinTcpOpen = LayDown(X_BinTcpRelease, reference, attempt);
+  } else if (drop < 0.0) {
     MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, drop)}, params_.lift_speed, &attempt);
+  }
   OpenGripper();
-  if (drop < 0.0)
-    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -drop)}, params_.approach_speed, &attempt);
-  Eigen::Isometry3d X_BinTcpReleased = X_BinTcpLift;
-  X_BinTcpReleased.translation().z() += std::min(drop, 0.0);
-  CheckToolEmpty(reference, "after_put_back", X_BinTcpReleased, attempt);
+  if (drop < 0.0) MoveTo(X_BinTcpPutBack, params_.approach_speed, &attempt);
+  CheckToolEmpty(reference, "after_put_back", X_BinTcpOpen, attempt);
   GoHome(&attempt);
+}
+
+Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpRelease,
+                                          const devices::WrenchReading& reference, Attempt& attempt) {
+  const double resting = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
+  for (const Eigen::Isometry3d& X_BinTcpStep :
+       DescentSteps(params_.put_back_step, CurrentPose(), X_BinTcpRelease)) {
+    MoveTo(X_BinTcpStep, params_.lift_speed, &attempt);
+    double weight = 0.0;
+    try {
+      weight =
+          PayloadOnTool(devices::AsWrench(reference), devices::AsWrench(ReadWrench()), X_BinTcpStep.linear())
+              .weight;
+    } catch (const CellFault& fault) {
+      if (!detail::ReadingsDisagree(fault)) throw;
+      // A tangle whose arms touch the heap swings and slides: readings that disagree say nothing
+      // of where it rests. Letting it go there dropped three trees out of a simulated bin.
+      attempt.record["wrench"]["put_back_unsettled"].push_back(X_BinTcpStep.translation().z());
+      continue;
+    }
+    if (weight >= resting) continue;
+    const double above = X_BinTcpStep.translation().z() - X_BinTcpRelease.translation().z();
+    attempt.record["put_back_touchdown"] = {{"above_release", above}, {"load", weight}};
+    spdlog::info(
+        "cell: round {}: the tubes put back rest on the heap {:.3f} m above the release height ({:.2f} N "
+        "still "
+        "hang on the tool, under half a tube's weight): opening there",
+        round_, above, weight);
+    return X_BinTcpStep;
+  }
+  if (!X_BinTcpRelease.isApprox(CurrentPose(), 1e-9)) MoveTo(X_BinTcpRelease, params_.lift_speed, &attempt);
+  return X_BinTcpRelease;
 }
 
 void CellController::CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,

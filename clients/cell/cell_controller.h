@@ -422,11 +422,17 @@ class CellController {
                         const devices::WrenchReading& lifted, const PlanPoses& poses,
                         const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
   /// Resolution motion `m` moved by `shift` (lift pose → hold pose), back to the hold pose, a new
-  /// reading and its analysis.
+  /// reading (into `after`) and its analysis.
   v1::AnalyzeWrenchResponse ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                              const devices::WrenchReading& reference,
                                              const Eigen::Translation3d& shift,
-                                             const Eigen::Isometry3d& X_BinTcpHold, Attempt& attempt);
+                                             const Eigen::Isometry3d& X_BinTcpHold, Attempt& attempt,
+                                             devices::WrenchReading* after);
+  /// Where several tubes not freed are put back: the lift pose, moved inward as far as their centre
+  /// of mass (from `held`, the last reading, taken with the lift pose's orientation) needs to lie
+  /// put_back_margin inside the walls (PlanPutBackShift); recorded under record["resolution"].
+  Eigen::Isometry3d PutBackPose(const devices::WrenchReading& reference, const devices::WrenchReading& held,
+                                const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) const;
   void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
              Attempt& attempt);
   /// From the current pose straight down to the place pose in steps of place_step, reading the F/T
@@ -448,9 +454,18 @@ class CellController {
   /// The tube is gone: record where and when, open (the fingers closed on nothing), home.
   void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);
-  /// Several tubes held after every resolution motion: lower them back into the bin and open.
+  /// Several tubes held after every resolution motion, the TCP at X_BinTcpPutBack (PutBackPose):
+  /// lower them to release_height above the grasp's height (at the lift pose in one move, further
+  /// inside in steps: LayDown), open, back up.
   void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
-               const devices::WrenchReading& reference, Attempt& attempt);
+               const Eigen::Isometry3d& X_BinTcpPutBack, const devices::WrenchReading& reference,
+               Attempt& attempt);
+  /// From the current pose straight down to X_BinTcpRelease in steps of put_back_step, reading the
+  /// F/T after each; stops where less than half a tube's weight still hangs on the tool (the tubes
+  /// rest on the heap); readings that disagree (a tangle swinging, sliding on the heap) go on down.
+  /// Returns where it stopped.
+  Eigen::Isometry3d LayDown(const Eigen::Isometry3d& X_BinTcpRelease, const devices::WrenchReading& reference,
+                            Attempt& attempt);
   /// Before the tool goes home empty-handed (after a failed grasp, a put-back, a nudge, the place):
   /// a reading against `reference` (the same gripper opening and, but for a turn about the
   /// vertical, orientation) that must weigh nothing, into record["wrench"][key]. A tube caught on

@@ -120,6 +120,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");
+  v("put_back_margin", p.put_back_margin, "m, their centre of mass at least this inside the walls");
+  v("put_back_step", p.put_back_step, "m: down to it in steps, opening where they rest; 0 = one move");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
   v("place_recheck_height", p.place_recheck_height, "m higher again when the load there is light");
   v("place_step", p.place_step,

@@ -53,6 +53,8 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");
+  RequireNonNegativeValue(put_back_margin, "put_back_margin");
+  RequireNonNegativeValue(put_back_step, "put_back_step");
   RequireNonNegativeValue(place_approach_height, "place_approach_height");
   RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
   RequireNonNegativeValue(place_step, "place_step");

@@ -11,18 +11,10 @@ namespace tubepick {
 ResolutionHold PlanResolutionHold(const Wrench& reference, const Wrench& lifted,
                                   const Eigen::Isometry3d& X_BinTcpLift,
                                   const Eigen::Vector3d& bin_inner_size, double wall_margin) {
-  RequireFiniteVector(reference.force, "reference.force");
-  RequireFiniteVector(reference.torque, "reference.torque");
-  RequireFiniteVector(lifted.force, "lifted.force");
-  RequireFiniteVector(lifted.torque, "lifted.torque");
   RequireRigid(X_BinTcpLift, "X_BinTcpLift");
   RequireNonNegative(wall_margin, "resolution_wall_margin");
-  const Eigen::Matrix3d R_BinTcp = X_BinTcpLift.linear();
-  const Eigen::Vector3d force_Bin = R_BinTcp * (lifted.force - reference.force);
-  const Eigen::Vector3d torque_Bin = R_BinTcp * (lifted.torque - reference.torque);
   ResolutionHold hold;
-  const double weight = -force_Bin.z();
-  if (weight > 0.0) hold.p_TcpPayload_Bin = Eigen::Vector3d(torque_Bin.y(), -torque_Bin.x(), 0.0) / weight;
+  hold.p_TcpPayload_Bin = PayloadOnTool(reference, lifted, X_BinTcpLift.linear()).p_TcpPayload_Bin;
   const Eigen::Vector3d tcp = X_BinTcpLift.translation();
   Eigen::Vector3d target = -hold.p_TcpPayload_Bin;
   for (int axis = 0; axis < 2; ++axis) {
@@ -31,6 +23,39 @@ ResolutionHold PlanResolutionHold(const Wrench& reference, const Wrench& lifted,
   }
   hold.shift_Bin = Eigen::Vector3d(target.x() - tcp.x(), target.y() - tcp.y(), 0.0);
   return hold;
+}
+
+Payload PayloadOnTool(const Wrench& reference, const Wrench& now, const Eigen::Matrix3d& R_BinTcp) {
+  RequireFiniteVector(reference.force, "reference.force");
+  RequireFiniteVector(reference.torque, "reference.torque");
+  RequireFiniteVector(now.force, "now.force");
+  RequireFiniteVector(now.torque, "now.torque");
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = R_BinTcp;
+  RequireRigid(X, "R_BinTcp");
+  const Eigen::Vector3d force_Bin = R_BinTcp * (now.force - reference.force);
+  const Eigen::Vector3d torque_Bin = R_BinTcp * (now.torque - reference.torque);
+  Payload payload;
+  payload.weight = -force_Bin.z();
+  // A load W at r below the sensor reads ΔM = r × (0, 0, −W): r_x = ΔM_y / W, r_y = −ΔM_x / W.
+  if (payload.weight > 0.0)
+    payload.p_TcpPayload_Bin = Eigen::Vector3d(torque_Bin.y(), -torque_Bin.x(), 0.0) / payload.weight;
+  return payload;
+}
+
+Eigen::Vector3d PlanPutBackShift(const Eigen::Vector3d& p_Bin_tcp, const Eigen::Vector3d& p_TcpPayload_Bin,
+                                 const Eigen::Vector3d& bin_inner_size, double margin) {
+  RequireFiniteVector(p_Bin_tcp, "p_Bin_tcp");
+  RequireFiniteVector(p_TcpPayload_Bin, "p_TcpPayload_Bin");
+  RequireFiniteVector(bin_inner_size, "bin_inner_size");
+  RequireNonNegative(margin, "put_back_margin");
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (int axis = 0; axis < 2; ++axis) {
+    const double reach = std::max(0.0, 0.5 * bin_inner_size[axis] - margin);
+    const double centre = p_Bin_tcp[axis] + p_TcpPayload_Bin[axis];
+    shift[axis] = std::clamp(centre, -reach, reach) - centre;
+  }
+  return shift;
 }
 
 }  // namespace tubepick

@@ -28,4 +28,25 @@ ResolutionHold PlanResolutionHold(const Wrench& reference, const Wrench& lifted,
                                   const Eigen::Isometry3d& X_BinTcpLift,
                                   const Eigen::Vector3d& bin_inner_size, double wall_margin);
 
+/// What hangs on the tool, from a reading `now` against the empty gripper's `reference` (sensor
+/// axes = TCP axes) with the TCP at orientation R_BinTcp.
+struct Payload {
+  /// Newtons; negative when the tool is pushed up (pressing on something).
+  double weight = 0.0;
+  /// The payload's centre of mass relative to the TCP, horizontal, bin frame (as
+  /// ResolutionHold::p_TcpPayload_Bin); zero when weight ≤ 0.
+  Eigen::Vector3d p_TcpPayload_Bin = Eigen::Vector3d::Zero();
+};
+/// @throws InvalidArgument when a reading is not finite or R_BinTcp is not a rotation.
+Payload PayloadOnTool(const Wrench& reference, const Wrench& now, const Eigen::Matrix3d& R_BinTcp);
+
+/// Translation (bin frame, z = 0) that brings a payload's centre of mass, hanging at
+/// p_TcpPayload_Bin from a TCP at p_Bin_tcp, at least `margin` inside the bin's inner walls, and no
+/// further: per axis, zero where it already is, to the bin's middle where the bin is narrower than
+/// two margins. Where several tubes the resolution could not free are put back: lowered where they
+/// hang, they lie down where they came from, but a centre of mass at a wall lays them over it.
+/// @throws InvalidArgument when a vector is not finite or margin < 0 (named put_back_margin).
+Eigen::Vector3d PlanPutBackShift(const Eigen::Vector3d& p_Bin_tcp, const Eigen::Vector3d& p_TcpPayload_Bin,
+                                 const Eigen::Vector3d& bin_inner_size, double margin);
+
 }  // namespace tubepick

@@ -279,6 +279,16 @@ TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {
             std::string::npos)
       << ParseError("safe_release_step: -0.03\n");
   EXPECT_EQ(ParseCellControllerParams("safe_release_step: 0.05\n").safe_release_step, 0.05);
+  EXPECT_NE(
+      ParseError("put_back_margin: -0.1\n").find("put_back_margin: must be a non-negative number, got -0.1"),
+      std::string::npos)
+      << ParseError("put_back_margin: -0.1\n");
+  EXPECT_EQ(ParseCellControllerParams("put_back_margin: 0.2\n").put_back_margin, 0.2);
+  EXPECT_NE(
+      ParseError("put_back_step: -0.02\n").find("put_back_step: must be a non-negative number, got -0.02"),
+      std::string::npos)
+      << ParseError("put_back_step: -0.02\n");
+  EXPECT_EQ(ParseCellControllerParams("put_back_step: 0\n").put_back_step, 0.0);
   EXPECT_NE(ParseError("wall_watch:\n  gone_distance: 0\n").find("wall_watch.gone_distance"),
             std::string::npos)
       << ParseError("wall_watch:\n  gone_distance: 0\n");

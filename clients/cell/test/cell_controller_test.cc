@@ -560,13 +560,16 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(result.picks, 0u);
   EXPECT_EQ(result.scans, 2u);
   EXPECT_EQ(planner.wrench_requests.size(), 3u);
-  // Lowered straight down to release_height above the grasp point, opened, back up.
+  // Its centre of mass well inside the walls (no torque): lowered where it was lifted, straight down
+  // in one move (the way it came up) to release_height above the grasp point, opened, back up.
+  const Eigen::Vector3d p_Bin_release = p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height);
   bool lowered = false;
   for (const testing::ScriptedRobot::Move& m : robot.moves)
-    if (m.through &&
-        m.X_BinTcpTarget.isApprox(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height)), kTol))
-      lowered = true;
+    if (m.through && m.X_BinTcpTarget.isApprox(DownPose(p_Bin_release), kTol)) lowered = true;
   EXPECT_TRUE(lowered);
+  EXPECT_FALSE(robot.Visited(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4 - params.put_back_step))));
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
+                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
   EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   EXPECT_TRUE(gripper.open);
 
@@ -574,7 +577,158 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(a["resolution"]["used"], 2);
   EXPECT_EQ(a["resolution"]["succeeded"], false);
   EXPECT_EQ(a["wrench"]["after_resolution"].size(), 2u);
+  EXPECT_EQ(a["resolution"]["put_back_shift"], json::array({0.0, 0.0}));
+  EXPECT_FALSE(a.contains("put_back_touchdown"));
   EXPECT_EQ(a["result"], "multiple_returned");
+}
+
+/// The reading of a payload of `weight` newtons hanging at r_Bin (horizontal, bin frame) from a TCP
+/// at orientation R_BinTcp, in the sensor's (TCP) axes, the empty tool reading zero.
+devices::WrenchReading PayloadReading(const Eigen::Matrix3d& R_BinTcp, double weight,
+                                      const Eigen::Vector3d& r_Bin) {
+  const Eigen::Vector3d force_Bin(0.0, 0.0, -weight);
+  devices::WrenchReading r;
+  r.force = R_BinTcp.transpose() * force_Bin;
+  r.torque = R_BinTcp.transpose() * r_Bin.cross(force_Bin);
+  return r;
+}
+
+TEST_F(CellControllerTest, TubesNotFreedWithTheirCentreOfMassAtAWallArePutBackFurtherInside) {
+  // Seed 14 of the 20-tree bins (2026-12-05): two trees lifted at the +x wall, their centre of mass
+  // 1 cm inside it, lowered there: both fell over the wall. Here: TCP at x = 0.30 m, the centre of
+  // mass 0.09 m further along +x (at 0.39 m in a 0.8 m bin), nothing to rotate.
+  const Eigen::Vector3d p_Bin_wall_grasp(0.30, -0.05, 0.03);
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_wall_grasp)}, 4));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0)};
+  const Eigen::Matrix3d R_BinTcp = DownPose(p_Bin_wall_grasp).linear();
+  ft.readings = {devices::WrenchReading{}, PayloadReading(R_BinTcp, 1.08, {0.09, 0.0, 0.0})};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 0u) << result.message;
+  // put_back_margin 0.15: the centre of mass to x = 0.25, the TCP to 0.16; y stays.
+  const Eigen::Vector3d p_Bin_release(0.16, -0.05, 0.03 + params.release_height);
+  EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.16, -0.05, 0.43))));
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
+                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
+  // Nowhere did the gripper open over the place where the tubes were lifted.
+  for (const Eigen::Vector3d& p : gripper.opened_at) EXPECT_GT(std::abs(p.x() - 0.30), 0.1) << p.transpose();
+  const json a = Records("attempt").at(0);
+  EXPECT_NEAR(a["resolution"]["put_back_payload_offset"][0].get<double>(), 0.09, 1e-9);
+  EXPECT_NEAR(a["resolution"]["put_back_shift"][0].get<double>(), -0.14, 1e-9);
+  EXPECT_NEAR(a["resolution"]["put_back_shift"][1].get<double>(), 0.0, 1e-9);
+  EXPECT_EQ(a["result"], "multiple_returned");
+}
+
+TEST_F(CellControllerTest, WithoutAPutBackMarginTubesAtAWallGoDownWhereTheyWereLifted) {
+  params.put_back_margin = 0.0;
+  const Eigen::Vector3d p_Bin_wall_grasp(0.30, -0.05, 0.03);
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_wall_grasp)}, 4));
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0)};
+  ft.readings = {devices::WrenchReading{},
+                 PayloadReading(DownPose(p_Bin_wall_grasp).linear(), 1.08, {0.09, 0.0, 0.0})};
+  Run();
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(), [&](const Eigen::Vector3d& p) {
+    return p.isApprox(p_Bin_wall_grasp + Eigen::Vector3d(0, 0, params.release_height), kTol);
+  }));
+  EXPECT_EQ(Records("attempt").at(0)["resolution"]["put_back_shift"], json::array({0.0, 0.0}));
+}
+
+/// A double pick at the +x wall (TCP at x = 0.30 m, the payload's centre of mass 0.09 m further):
+/// put back 0.14 m further inside, over a heap it did not come up through.
+class PutBackInsideTest : public CellControllerTest {
+ protected:
+  void SetUp() override {
+    CellControllerTest::SetUp();
+    planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_wall_grasp)}, 4));
+    planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0)};
+    ft.tcp = &robot.X_BinTcp;
+  }
+  devices::WrenchReading Lifted() const {
+    return PayloadReading(DownPose(p_Bin_wall_grasp).linear(), 1.08, {0.09, 0.0, 0.0});
+  }
+  const Eigen::Vector3d p_Bin_wall_grasp{0.30, -0.05, 0.03};
+  const Eigen::Vector3d p_Bin_release{0.16, -0.05, 0.03 + params.release_height};
+  const double top = 0.43;
+  /// The put-back's stops at (0.16, -0.05), in order, up to the lift height (not home's transit).
+  std::vector<double> Stops() const {
+    std::vector<double> z;
+    for (const auto& m : robot.moves) {
+      const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+      if ((q.head<2>() - p_Bin_release.head<2>()).norm() < kTol && q.z() < top + kTol) z.push_back(q.z());
+    }
+    return z;
+  }
+};
+
+TEST_F(PutBackInsideTest, TubesAreLetGoWhereTheyRestOnTheHeapNotPressedIntoIt) {
+  ft.readings = {devices::WrenchReading{}, Lifted()};
+  ft.rests_below_z = 0.25;  // the heap takes the load from 0.25 m down
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 0u) << result.message;
+  const int steps = static_cast<int>(std::ceil((top - p_Bin_release.z()) / params.put_back_step - 1e-9));
+  const double step = (top - p_Bin_release.z()) / steps;
+  const std::vector<double> stops = Stops();
+  // The put-back pose, the steps down to the first at or below 0.25 m, back up to the put-back pose.
+  ASSERT_GE(stops.size(), 3u);
+  EXPECT_NEAR(stops.front(), top, kTol);
+  EXPECT_NEAR(stops.back(), top, kTol);
+  const double z_open = stops[stops.size() - 2];
+  EXPECT_LE(z_open, 0.25 + kTol);
+  EXPECT_GT(z_open + step, 0.25 + kTol);
+  EXPECT_EQ(stops.size(), static_cast<std::size_t>(std::lround((top - z_open) / step)) + 2);
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(), [&](const Eigen::Vector3d& p) {
+    return p.isApprox(Eigen::Vector3d(0.16, -0.05, z_open), kTol);
+  }));
+  const json a = Records("attempt").at(0);
+  EXPECT_NEAR(a["put_back_touchdown"]["above_release"].get<double>(), z_open - p_Bin_release.z(), 1e-9);
+  EXPECT_NEAR(a["put_back_touchdown"]["load"].get<double>(), 0.0, 1e-9);
+}
+
+TEST_F(PutBackInsideTest, OverALowHeapTubesGoDownToTheReleaseHeightInSteps) {
+  ft.readings = {devices::WrenchReading{}, Lifted()};
+  Run();
+  const std::vector<double> stops = Stops();
+  const int steps = static_cast<int>(std::ceil((top - p_Bin_release.z()) / params.put_back_step - 1e-9));
+  // The put-back pose, steps - 1 stops on the way, the release, back up.
+  ASSERT_EQ(stops.size(), static_cast<std::size_t>(steps) + 2);
+  for (int k = 0; k <= steps; ++k)
+    EXPECT_NEAR(stops[k], top - (top - p_Bin_release.z()) * k / steps, kTol) << k;
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
+                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
+  EXPECT_FALSE(Records("attempt").at(0).contains("put_back_touchdown"));
+}
+
+TEST_F(PutBackInsideTest, TubesWhoseReadingsDisagreeGoOnDownNotDroppedThere) {
+  // A tangle touching the heap swings and slides: the readings of the first step disagree. Seed 14
+  // of the 20-tree bins, opened there (0.10 m above the release height), lost three trees.
+  params.ft_samples = 3;
+  params.ft_unsettled_retries = 0;
+  const devices::WrenchReading none{}, lifted = Lifted();
+  devices::WrenchReading swing = lifted;
+  ft.readings = {none, none, none, lifted, lifted, lifted, swing, swing, swing};
+  ft.readings[6].force.z() += 10.0;
+  ft.readings[8].force.z() -= 12.0;
+  ft.readings.push_back(lifted);
+  const CellRunResult result = Run();
+  EXPECT_FALSE(result.fault) << result.message;
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
+                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
+  const json a = Records("attempt").at(0);
+  ASSERT_EQ(a["wrench"]["put_back_unsettled"].size(), 1u);
+  const int steps = static_cast<int>(std::ceil((top - p_Bin_release.z()) / params.put_back_step - 1e-9));
+  EXPECT_NEAR(a["wrench"]["put_back_unsettled"][0].get<double>(), top - (top - p_Bin_release.z()) / steps,
+              1e-9);
+  EXPECT_FALSE(a.contains("put_back_touchdown"));
+}
+
+TEST_F(PutBackInsideTest, WithoutStepsTubesGoDownInOneMove) {
+  params.put_back_step = 0.0;
+  ft.readings = {devices::WrenchReading{}, Lifted()};
+  ft.rests_below_z = 0.25;  // not read
+  Run();
+  EXPECT_EQ(Stops().size(), 3u);  // the put-back pose, the release, back up
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
+                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
 }
 
 TEST_F(CellControllerTest, AttemptLimitPerTubeStopsWithTheReason) {

@@ -66,7 +66,7 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::Ce
 // hold pose and a reading, until the F/T says one tube (or none).
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
-             ResolutionTrial& trial) {
+             ResolutionTrial& trial, Wrench* held) {
   const cell::CellControllerParams& c = tp.controller;
   const double tube_mass = cell.cell().tube.mass;
   const Eigen::Translation3d shift(
@@ -83,8 +83,8 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
       cell.robot().MoveTo(shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (tp.dwell > 0.0) cell.Advance(tp.dwell);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
-    const HeldCount again =
-        CountHeldTubes(reference, AsWrench(cell.ft_sensor().Read(kLong)), tube_mass, params);
+    *held = AsWrench(cell.ft_sensor().Read(kLong));
+    const HeldCount again = CountHeldTubes(reference, *held, tube_mass, params);
     if (again.outcome != HeldOutcome::kMultiple) {
       trial.freed = again.outcome == HeldOutcome::kSingle;
       return;
@@ -103,6 +103,39 @@ std::uint32_t OthersLifted(const SimCell& cell, std::size_t tube) {
     });
   }
   return lifted;
+}
+
+// Several tubes not freed, put back as the controller does (CellController::PutBack): from the lift
+// pose, or from further inside when their centre of mass (`held`, the last reading) lies less than
+// put_back_margin inside a wall (PlanPutBackShift), then down in put_back_step steps until less
+// than half a tube's weight hangs on the tool; opened, up, and the tool's load read there.
+void PutBackSeveral(SimCell& cell, const TrialGrasp& grasp, const Wrench& reference, const Wrench& held,
+                    const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp, ResolutionTrial& trial) {
+  const cell::CellControllerParams& c = tp.controller;
+  const Eigen::Matrix3d R_BinTcp = X_BinTcpLift.linear();
+  const Eigen::Vector3d shift =
+      PlanPutBackShift(X_BinTcpLift.translation(), PayloadOnTool(reference, held, R_BinTcp).p_TcpPayload_Bin,
+                       cell.cell().bin.inner_size, c.put_back_margin);
+  trial.put_back_shift = shift.norm();
+  const Eigen::Isometry3d X_BinTcpPutBack = Eigen::Translation3d(shift) * X_BinTcpLift;
+  cell.robot().MoveTo(X_BinTcpPutBack, c.lift_speed, kLong);
+  Eigen::Isometry3d X_BinTcpRelease = X_BinTcpPutBack;
+  X_BinTcpRelease.translation().z() = grasp.X_BinTcp.translation().z() + c.release_height;
+  const double resting = 0.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
+  if (!shift.isZero()) {
+    for (const Eigen::Isometry3d& X_BinTcpStep :
+         cell::DescentSteps(c.put_back_step, X_BinTcpPutBack, X_BinTcpRelease)) {
+      cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
+      if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight < resting) {
+        X_BinTcpRelease = X_BinTcpStep;
+        break;
+      }
+    }
+  }
+  cell.robot().MoveTo(X_BinTcpRelease, c.lift_speed, kLong);
+  cell.gripper().MoveTo(kTrialOpening, kOpenSpeed, kGripForce, kLong);
+  cell.robot().MoveTo(X_BinTcpPutBack, c.approach_speed, kLong);
+  trial.caught = PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight > resting;
 }
 
 // One lift of the trial: grasp from 10 cm above (reference reading there), lift, read. With several
@@ -131,13 +164,16 @@ void LiftAndResolve(SimCell& cell, const TrialGrasp& grasp, const WrenchParams& 
   trial.multiple = CountHeldTubes(reference, lifted, mass, at_lift).outcome == HeldOutcome::kMultiple;
   if (trial.multiple) {
     trial.others_lifted = OthersLifted(cell, grasp.tube);
+    Wrench held = lifted;
     if (const std::optional<ResolutionPlan> plan =
-            PlanResolutionRotation(reference, lifted, X_BinTcpLift, at_lift))
-      Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift, tp, trial);
+            PlanResolutionRotation(reference, lifted, X_BinTcpLift, at_lift);
+        plan && tp.resolve)
+      Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift, tp, trial, &held);
     if (trial.freed) return;  // held: the freed tubes fell, counted at the end
-    cell.robot().MoveTo(X_BinTcpLift, c.lift_speed, kLong);
+    PutBackSeveral(cell, grasp, reference, held, X_BinTcpLift, tp, trial);
+    return;
   }
-  // Put back, as the controller does with one tube here or several it could not free.
+  // Put back, as the controller does with one tube here.
   cell.robot().MoveTo(Above(grasp.X_BinTcp, c.release_height), c.lift_speed, kLong);
   open();
   cell.robot().MoveTo(above, c.approach_speed, kLong);
@@ -266,6 +302,7 @@ namespace {
 // Counts over the bins of one material, variant and angle.
 struct ArmSummary {
   std::uint32_t bins = 0, lifts = 0, multiple = 0, freed = 0, second_motion = 0, outside = 0, faults = 0;
+  std::uint32_t put_back = 0, moved_inside = 0, caught = 0;
 };
 
 std::vector<ResolutionTrial> RunArm(const SimCellParams& base, const WrenchParams& wrench,
@@ -305,6 +342,10 @@ ArmSummary Summarise(const std::vector<ResolutionTrial>& trials) {
     ++s.multiple;
     s.freed += t.freed;
     s.second_motion += t.freed && t.motions_used > 1;
+    if (t.freed || !t.fault.empty()) continue;
+    ++s.put_back;
+    s.moved_inside += t.put_back_shift > 0.0;
+    s.caught += t.caught;
   }
   return s;
 }
@@ -322,6 +363,8 @@ nlohmann::json TrialJson(const ResolutionTrial& t) {
           {"tube_held", t.tube_held},
           {"outside_at_start", t.outside_at_start},
           {"others_outside", t.others_outside},
+          {"put_back_shift", t.put_back_shift},
+          {"caught", t.caught},
           {"fault", t.fault}};
 }
 
@@ -334,8 +377,9 @@ void RunTrials(const ResolutionTrialsOptions& o) {
   nlohmann::json json = nlohmann::json::array();
   fmt::print(
       "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by the 2nd "
-      "motion | tubes outside the bin | gripper or robot faults |\n"
-      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "motion | put back: moved inside, caught on the tool | tubes outside the bin | gripper or robot faults "
+      "|\n"
+      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const std::string& material_name : o.materials) {
     const Material material = devices::sim::ParseMaterial(material_name, "--materials");
     SimCellParams params = SimCellParams::Thesis(material, o.tubes, o.seed);
@@ -349,9 +393,10 @@ void RunTrials(const ResolutionTrialsOptions& o) {
         wrench.Validate();
         const std::vector<ResolutionTrial> trials = RunArm(params, wrench, o);
         const ArmSummary s = Summarise(trials);
-        fmt::print("| {} | {} | {} | {:.0f}° | {} | {} | {} | {} ({}) | {} | {} | {} |\n", material_name,
-                   shapes, variant, angle, s.bins, s.lifts, s.multiple, s.freed, Percent(s.freed, s.multiple),
-                   s.second_motion, s.outside, s.faults);
+        fmt::print("| {} | {} | {} | {:.0f}° | {} | {} | {} | {} ({}) | {} | {}: {}, {} | {} | {} |\n",
+                   material_name, shapes, variant, angle, s.bins, s.lifts, s.multiple, s.freed,
+                   Percent(s.freed, s.multiple), s.second_motion, s.put_back, s.moved_inside, s.caught,
+                   s.outside, s.faults);
         nlohmann::json arm = {{"material", material_name}, {"shapes", shapes},
                               {"variant", variant},        {"angle_deg", angle},
                               {"tubes", o.tubes},          {"lift", o.trial.lift},
@@ -390,6 +435,12 @@ void ValidateResolutionTrials(const ResolutionTrialsOptions& o) {
         fmt::format("--lift: {} m (the lift before the reading must be positive)", o.trial.lift));
   if (!(o.trial.dwell >= 0.0))
     throw InvalidArgument(fmt::format("--dwell: {} s (a wait, at least 0)", o.trial.dwell));
+  if (!(o.trial.controller.put_back_margin >= 0.0))
+    throw InvalidArgument(fmt::format("--put-back-margin: {} m (inside the bin walls, at least 0)",
+                                      o.trial.controller.put_back_margin));
+  if (!(o.trial.controller.put_back_step >= 0.0))
+    throw InvalidArgument(
+        fmt::format("--put-back-step: {} m (a step down, at least 0)", o.trial.controller.put_back_step));
   if (!(o.trial.controller.resolution_wall_margin >= 0.0))
     throw InvalidArgument(fmt::format("--wall-margin: {} m (inside the bin walls, at least 0)",
                                       o.trial.controller.resolution_wall_margin));
@@ -424,6 +475,15 @@ void AddResolutionTrialsCommand(CLI::App& app) {
                   "The hold pose's TCP inside the bin walls, metres")
       ->capture_default_str();
   cmd->add_option("--dwell", o->trial.dwell, "Wait at the end of each resolution motion, seconds")
+      ->capture_default_str();
+  cmd->add_option("--resolve", o->trial.resolve,
+                  "Run the resolution; false: every double pick is put back at once (the put-back alone)")
+      ->capture_default_str();
+  cmd->add_option("--put-back-margin", o->trial.controller.put_back_margin,
+                  "Tubes not freed: their centre of mass at least this inside the walls, metres")
+      ->capture_default_str();
+  cmd->add_option("--put-back-step", o->trial.controller.put_back_step,
+                  "... and, moved inside, lowered in steps of this, metres (0 = one move)")
       ->capture_default_str();
   cmd->add_option("--max-lifts", o->trial.max_lifts, "Lifts per bin until one holds several tubes")
       ->check(CLI::Range(1, 100))

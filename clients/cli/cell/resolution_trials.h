@@ -53,6 +53,11 @@ struct ResolutionTrial {
   /// freed tube must fall back into the bin).
   bool tube_held = false;
   std::uint32_t others_outside = 0;
+  /// Several tubes not freed and put back: how far the put-back pose lay from the lift pose
+  /// (PlanPutBackShift), metres; and whether, opened and back up, the tool still carried more than
+  /// half a tube's weight (a tube caught on the pads or the housing).
+  double put_back_shift = 0.0;
+  bool caught = false;
   /// Tubes outside the bin before the first lift (the generated drop can leave one on a wall).
   std::uint32_t outside_at_start = 0;
   /// The gripper closed on nothing, or the robot refused or stopped a motion: the message.
@@ -67,6 +72,8 @@ struct TrialParams {
   std::uint32_t max_lifts = 6;
   /// Wait at the end of each resolution motion before the return to the hold pose, seconds.
   double dwell = 0.0;
+  /// Run the resolution on a double pick; false: put it back at once (measures the put-back alone).
+  bool resolve = true;
   /// The controller's speeds, approach and release heights and resolution hold
   /// (resolution_hold_over_bin: the payload brought over the bin's middle, PlanResolutionHold,
   /// before the rotation, the TCP resolution_wall_margin inside the walls).
@@ -78,8 +85,9 @@ struct TrialParams {
 /// F/T read there. A lift that holds one tube puts it back (lowered to 3 cm above the grasp,
 /// opened); the first that holds several (Algorithm 3) gets the resolution of `wrench`
 /// (WrenchParamsAtPose at the lift pose) at the hold pose (hold_over_bin), each motion at 0.1 m/s,
-/// a dwell and back to the hold pose, read again, until one tube is left, and ends the trial (back
-/// to the lift pose and put back when none freed). Every
+/// a dwell and back to the hold pose, read again, until one tube is left, and ends the trial (put
+/// back as the controller puts back several tubes, put_back_margin and put_back_step, when none
+/// freed). Every
 /// variant meets the same double pick: the simulation is deterministic up to the resolution. Same
 /// params ⇒ same trial.
 ResolutionTrial RunResolutionTrial(const devices::sim::SimCellParams& params, const WrenchParams& wrench,

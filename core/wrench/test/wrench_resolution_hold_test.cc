@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "core/common/errors.h"
 
@@ -80,6 +81,50 @@ TEST(ResolutionHold, RejectsBadInputsByName) {
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("resolution_wall_margin"), std::string::npos) << e.what();
   }
+}
+
+TEST(PayloadOnTool, ReadsTheWeightAndWhereItHangs) {
+  const Eigen::Isometry3d X = LiftPose({0.3, -0.1, 0.5});
+  const Payload payload =
+      PayloadOnTool(kReference, Loaded(kReference, X, 1.6, {-0.12, 0.07, -0.3}), X.linear());
+  EXPECT_NEAR(payload.weight, 1.6, 1e-12);
+  EXPECT_NEAR(payload.p_TcpPayload_Bin.x(), -0.12, 1e-12);
+  EXPECT_NEAR(payload.p_TcpPayload_Bin.y(), 0.07, 1e-12);
+  // The tool pushed up by 0.5 N: a negative weight and no lever arm.
+  const Payload pressing =
+      PayloadOnTool(kReference, Loaded(kReference, X, -0.5, {0.1, 0.1, 0.0}), X.linear());
+  EXPECT_NEAR(pressing.weight, -0.5, 1e-12);
+  EXPECT_EQ(pressing.p_TcpPayload_Bin, Eigen::Vector3d::Zero());
+  Wrench bad = kReference;
+  bad.force.z() = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(PayloadOnTool(kReference, bad, X.linear()), InvalidArgument);
+  EXPECT_THROW(PayloadOnTool(kReference, kReference, 2.0 * X.linear()), InvalidArgument);
+}
+
+TEST(PutBackShift, MovesACentreOfMassAtAWallOnlyAsFarInsideAsTheMarginAsks) {
+  // Seed 14's tangle (2026-12-05): TCP at x = 0.21 m, its centre of mass 0.18 m further along +x,
+  // 1 cm inside the +x wall of a 0.8 m bin. With a 0.15 m margin it goes to x = 0.25 m.
+  const Eigen::Vector3d shift = PlanPutBackShift({0.21, 0.05, 0.45}, {0.18, -0.18, 0.0}, kBin, 0.15);
+  EXPECT_NEAR(shift.x(), 0.25 - 0.39, 1e-12);
+  // y: 0.05 - 0.18 = -0.13, inside |y| <= 0.15: not moved.
+  EXPECT_EQ(shift.y(), 0.0);
+  EXPECT_EQ(shift.z(), 0.0);
+  // Already inside on both axes: no move at all (the put-back lays it where it came from).
+  EXPECT_EQ(PlanPutBackShift({0.1, 0.05, 0.45}, {0.05, 0.02, 0.0}, kBin, 0.15), Eigen::Vector3d::Zero());
+  // Past the -y wall (y = -0.35) back to y = -0.15.
+  EXPECT_NEAR(PlanPutBackShift({0.0, -0.2, 0.45}, {0.0, -0.15, 0.0}, kBin, 0.15).y(), 0.2, 1e-12);
+  // A bin narrower than two margins: to its middle.
+  EXPECT_NEAR(PlanPutBackShift({0.0, 0.1, 0.45}, {0.0, 0.05, 0.0}, kBin, 0.4).y(), -0.15, 1e-12);
+}
+
+TEST(PutBackShift, RejectsANegativeMarginByName) {
+  try {
+    PlanPutBackShift({0.0, 0.0, 0.4}, {0.0, 0.0, 0.0}, kBin, -0.1);
+    FAIL() << "a negative margin was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("put_back_margin"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(PlanPutBackShift({std::nan(""), 0.0, 0.4}, {0.0, 0.0, 0.0}, kBin, 0.1), InvalidArgument);
 }
 
 }  // namespace

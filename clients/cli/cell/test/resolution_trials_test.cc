@@ -64,6 +64,24 @@ TEST(ResolutionTrials, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
   EXPECT_EQ(cell.TubesInBin(), 1u);  // B fell back; A is held above the bin
 }
 
+TEST(ResolutionTrials, WithoutTheResolutionADoublePickIsPutBackAsTheControllerDoes) {
+  const SimCellParams params;
+  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+  TrialParams tp;
+  tp.resolve = false;
+  const ResolutionTrial trial = RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), tp);
+  EXPECT_EQ(trial.fault, "");
+  EXPECT_TRUE(trial.multiple);
+  EXPECT_EQ(trial.motions_used, 0u);
+  EXPECT_FALSE(trial.freed);
+  // Their centre of mass near the bin's middle: back where they were lifted, and let go.
+  EXPECT_EQ(trial.put_back_shift, 0.0);
+  EXPECT_FALSE(trial.caught);
+  EXPECT_FALSE(trial.tube_held);
+  EXPECT_EQ(trial.others_outside, 0u);
+  EXPECT_EQ(cell.TubesInBin(), 2u);
+}
+
 std::string ErrorOf(const ResolutionTrialsOptions& o) {
   try {
     ValidateResolutionTrials(o);
@@ -94,6 +112,10 @@ TEST(ResolutionTrials, EveryBadOptionIsRefusedByNameBeforeATrialRuns) {
   EXPECT_THAT(with([](auto& o) { o.trial.dwell = -1.0; }), HasSubstr("--dwell: -1 s"));
   EXPECT_THAT(with([](auto& o) { o.trial.controller.resolution_wall_margin = -0.1; }),
               HasSubstr("--wall-margin: -0.1 m"));
+  EXPECT_THAT(with([](auto& o) { o.trial.controller.put_back_margin = -0.2; }),
+              HasSubstr("--put-back-margin: -0.2 m"));
+  EXPECT_THAT(with([](auto& o) { o.trial.controller.put_back_step = -0.01; }),
+              HasSubstr("--put-back-step: -0.01 m"));
 }
 
 // PlanPick from a queue; AnalyzeWrench is the real analysis (the fast profile's, as the server's).
