@@ -495,9 +495,8 @@ Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpRelea
     const double above = X_BinTcpStep.translation().z() - X_BinTcpRelease.translation().z();
     attempt.record["put_back_touchdown"] = {{"above_release", above}, {"load", weight}};
     spdlog::info(
-        "cell: round {}: the tubes put back rest on the heap {:.3f} m above the release height ({:.2f} N "
-        "still "
-        "hang on the tool, under half a tube's weight): opening there",
+        "cell: round {}: the tubes put back rest on the heap {:.3f} m above the release height "
+        "({:.2f} N still hang on the tool, under half a tube's weight): opening there",
         round_, above, weight);
     return X_BinTcpStep;
   }
