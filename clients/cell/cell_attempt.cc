@@ -463,7 +463,7 @@ void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen
   const double drop = X_BinTcpRelease.translation().z() - X_BinTcpPutBack.translation().z();
   Eigen::Isometry3d X_BinTcpOpen = X_BinTcpRelease;
   if (moved_inward) {
-    X_BinTcpOpen = LayDown(X_BinTcpRelease, reference, attempt);
+    X_BinTcpOpen = LayDown(X_BinTcpPutBack, X_BinTcpRelease, reference, attempt);
   } else if (drop < 0.0) {
     MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, drop)}, params_.lift_speed, &attempt);
   }
@@ -473,11 +473,12 @@ void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen
   GoHome(&attempt);
 }
 
-Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpRelease,
+Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpFrom,
+                                          const Eigen::Isometry3d& X_BinTcpRelease,
                                           const devices::WrenchReading& reference, Attempt& attempt) {
-  const double resting = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
+  const double resting = 0.5 * TubeWeight();
   for (const Eigen::Isometry3d& X_BinTcpStep :
-       DescentSteps(params_.put_back_step, CurrentPose(), X_BinTcpRelease)) {
+       DescentSteps(params_.put_back_step, X_BinTcpFrom, X_BinTcpRelease)) {
     MoveTo(X_BinTcpStep, params_.lift_speed, &attempt);
     double weight = 0.0;
     try {
@@ -500,7 +501,8 @@ Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpRelea
         round_, above, weight);
     return X_BinTcpStep;
   }
-  if (!X_BinTcpRelease.isApprox(CurrentPose(), 1e-9)) MoveTo(X_BinTcpRelease, params_.lift_speed, &attempt);
+  if (X_BinTcpRelease.translation().z() < X_BinTcpFrom.translation().z() - detail::kSameHeight)
+    MoveTo(X_BinTcpRelease, params_.lift_speed, &attempt);
   return X_BinTcpRelease;
 }
 
@@ -526,13 +528,17 @@ void CellController::CheckToolEmpty(const devices::WrenchReading& reference, con
   caught_reference_ = reference;
   // What still hangs on the tool is (part of) the tube the place let go: not placed.
   if (placing) attempt.record["placed"] = false;
-  const double tube_weight = cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
+  const double tube_weight = TubeWeight();
   const Eigen::Vector3d p = X_BinTcpUp.translation();
   throw CellFault("ft_sensor", FaultKind::kUnexpectedLoad, ToString(state_),
                   fmt::format("the tool carries {:.2f} N ({:.1f} times a tube's weight) after letting go, at "
                               "X_BinTcp ({:.3f}, {:.3f}, {:.3f}) m, also after lowering it {} once: a "
                               "tube caught on the pads or the housing?",
                               *load, *load / tube_weight, p.x(), p.y(), p.z(), lowered));
+}
+
+double CellController::TubeWeight() const {
+  return cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
 }
 
 std::optional<double> CellController::LoadOnTool(const devices::WrenchReading& reference,

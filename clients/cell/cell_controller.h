@@ -460,12 +460,12 @@ class CellController {
   void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
                const Eigen::Isometry3d& X_BinTcpPutBack, const devices::WrenchReading& reference,
                Attempt& attempt);
-  /// From the current pose straight down to X_BinTcpRelease in steps of put_back_step, reading the
-  /// F/T after each; stops where less than half a tube's weight still hangs on the tool (the tubes
-  /// rest on the heap); readings that disagree (a tangle swinging, sliding on the heap) go on down.
-  /// Returns where it stopped.
-  Eigen::Isometry3d LayDown(const Eigen::Isometry3d& X_BinTcpRelease, const devices::WrenchReading& reference,
-                            Attempt& attempt);
+  /// From X_BinTcpFrom (where the TCP is) straight down to X_BinTcpRelease in steps of put_back_step, reading
+  /// the F/T after each; stops where less than half a tube's weight still hangs on the tool (the tubes rest
+  /// on the heap); readings that disagree (a tangle swinging, sliding on the heap) go on down. Returns where
+  /// it stopped.
+  Eigen::Isometry3d LayDown(const Eigen::Isometry3d& X_BinTcpFrom, const Eigen::Isometry3d& X_BinTcpRelease,
+                            const devices::WrenchReading& reference, Attempt& attempt);
   /// Before the tool goes home empty-handed (after a failed grasp, a put-back, a nudge, the place):
   /// a reading against `reference` (the same gripper opening and, but for a turn about the
   /// vertical, orientation) that must weigh nothing, into record["wrench"][key]. A tube caught on
@@ -475,6 +475,8 @@ class CellController {
   /// false), so the safe stop carries it over the bin's middle, lowers it and opens there.
   void CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,
                       const Eigen::Isometry3d& X_BinTcpShed, Attempt& attempt);
+  /// One tube's weight, N: tube.mass · the profile's gravity.
+  double TubeWeight() const;
   /// The force `now` adds to `reference` (the same opening and orientation: whatever the tilt, a
   /// caught tube adds its weight), newtons, when it is more than F_tol of Algorithm 3 (not noise);
   /// nullopt otherwise.

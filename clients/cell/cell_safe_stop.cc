@@ -13,7 +13,6 @@
 #include "clients/cell/attempt_record.h"
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_controller_internal.h"
-#include "clients/cell/local_wrench_analysis.h"
 
 namespace tubepick::cell {
 namespace {
@@ -114,7 +113,7 @@ Eigen::Isometry3d CellController::DescendIntoBin(const Eigen::Isometry3d& X_BinT
   const std::optional<devices::WrenchReading> over_bin = steps.empty() ? std::nullopt : SafeStopReading(rest);
   // Half a tube's weight: the held tube resting on the heap lightens the load by about its weight
   // (or more, the tool pressing); a swing after a step does not.
-  const double contact = 0.5 * cell_.tube.mass * ProfileWrenchParams(params_.profile).gravity;
+  const double contact = 0.5 * TubeWeight();
   if (over_bin) {
     for (const Eigen::Isometry3d& X_BinTcpStep : steps) {
       devices_.robot->MoveTo(X_BinTcpStep, params_.approach_speed, params_.robot_timeout);
