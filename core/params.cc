@@ -72,6 +72,12 @@ void Params::Validate() const {
   planning.Validate();
   wrench.Validate();
   placement.Validate();
+  // A lift from a tilted grasp is analysed at the grasp's tilt: AnalyzeWrench would refuse it.
+  if (planning.grasps.max_tilt > wrench.max_tilt) {
+    throw InvalidArgument("planning.grasps.max_tilt: " + std::to_string(planning.grasps.max_tilt) +
+                          " rad exceeds wrench.max_tilt " + std::to_string(wrench.max_tilt) +
+                          " rad: AnalyzeWrench would refuse the lifts of the most tilted grasps");
+  }
 }
 
 std::vector<std::string> ProfileNames() { return {"fast", "thesis"}; }

@@ -237,6 +237,8 @@ void DescribeFields(Visit& v, GraspParams& p) {
   v("min_base_distance", p.min_base_distance);
   v("opening_width", p.opening_width);
   v("max_axis_inclination", p.max_axis_inclination);
+  v("max_tilt", p.max_tilt);
+  v("tilt_step", p.tilt_step);
 }
 
 template <typename Visit>

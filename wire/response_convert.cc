@@ -31,6 +31,7 @@ v1::PickPlan PickPlanToProto(const PickPlan& plan) {
   p.set_tube_id(plan.tube_id);
   *p.mutable_grasp()->mutable_tcp_pose() = ToProto(plan.grasp.X_BinTcp);
   *p.mutable_grasp()->mutable_approach() = ToProto(plan.grasp.approach_Bin);
+  p.mutable_grasp()->set_tilt(plan.grasp.tilt);
   p.mutable_grasp()->set_opening_width(plan.grasp.opening_width);
   for (const Eigen::Vector3d& w : plan.waypoints) *p.add_waypoints() = ToProto(w);
   p.set_trajectory_kind(ToProto(plan.kind));
@@ -59,6 +60,7 @@ v1::PlanningCounts CountsToProto(const PlanningCounts& c) {
   pc.set_rejected_tool(c.rejected_tool);
   pc.set_rejected_fingers(c.rejected_fingers);
   pc.set_rejected_approach(c.rejected_approach);
+  pc.set_tilted_grasps(c.tilted_grasps);
   pc.set_non_occluded_lain_on(c.non_occluded_lain_on);
   pc.set_short_tubes_planned(c.short_tubes_planned);
   return pc;

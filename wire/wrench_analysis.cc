@@ -34,7 +34,7 @@ WrenchParams WrenchParamsAtPose(WrenchParams params, const Eigen::Isometry3d& X_
   if (tilt > params.max_tilt) {
     throw InvalidArgument("tcp_pose.orientation: the TCP z axis is " + Degrees(tilt) +
                           " from the vertical (wrench.max_tilt " + Degrees(params.max_tilt) +
-                          "); the gripper must be vertical at lift");
+                          "); the gripper must be vertical at lift, or tilted no more than a grasp is");
   }
   // A joint-safe axis fixed in the TCP frame is horizontal for the configured up_Tcp; re-project it
   // onto the horizontal plane of this pose (it differs by at most max_tilt).

@@ -52,10 +52,11 @@ nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& 
 }
 
 nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
-                         double opening_width) {
+                         double opening_width, double tilt) {
   return {{"tcp_pose", PoseJson(X_BinTcpGrasp)},
           {"approach", VectorJson(approach_Bin)},
-          {"opening_width", opening_width}};
+          {"opening_width", opening_width},
+          {"tilt", tilt}};
 }
 
 nlohmann::json AnalysisJson(const v1::AnalyzeWrenchResponse& analysis) {

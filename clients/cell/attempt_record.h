@@ -43,9 +43,10 @@ void RecordPlan(nlohmann::json& record, const v1::PickPlan& plan);
 nlohmann::json SkippedPlanJson(int rank, std::uint32_t tube, const std::string& check,
                                const std::string& reason);
 
-/// {"tcp_pose", "approach", "opening_width"}.
+/// {"tcp_pose", "approach", "opening_width", "tilt"} (tilt: the plan's turn away from the
+/// vertical approach, radians).
 nlohmann::json GraspJson(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Vector3d& approach_Bin,
-                         double opening_width);
+                         double opening_width, double tilt);
 
 /// {"outcome", "estimated_count", "tube_ratio", "held_weight", "tube_weight", "force_tolerance",
 /// "motions"}.

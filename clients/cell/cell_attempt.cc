@@ -19,6 +19,9 @@
 #include "wire/proto_convert.h"
 
 namespace tubepick::cell {
+using detail::CallDevice;
+using detail::PlannerPose;
+
 namespace {
 
 /// The plan's unit approach direction (bin axes); the TCP's z axis when the plan gives none.
@@ -43,10 +46,23 @@ std::vector<Eigen::Vector3d> WaypointsOf(const v1::PickPlan& plan) {
   return waypoints_Bin;
 }
 
-}  // namespace
+/// Why motion m of a resolution, turned about the TCP at the hold pose (`shift` from the lift
+/// pose), leaves the arm's reach or wrist limits (a tool tilted at the grasp turned further), or
+/// nullopt.
+std::optional<std::string> ResolutionReachProblem(const devices::RobotLimits& limits,
+                                                  const v1::ResolutionMotion& motion, int m,
+                                                  const Eigen::Translation3d& shift, CellState state) {
+  for (int w = 0; w < motion.waypoints_size(); ++w) {
+    const Eigen::Isometry3d X_BinTcp =
+        shift * PlannerPose(motion.waypoints(w).tcp_pose(),
+                            fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state);
+    if (std::string problem = limits.Problem(X_BinTcp); !problem.empty())
+      return fmt::format("waypoint {}: {}", w, problem);
+  }
+  return std::nullopt;
+}
 
-using detail::CallDevice;
-using detail::PlannerPose;
+}  // namespace
 
 // ---------------------------------------------------------------- plan
 
@@ -113,7 +129,8 @@ void CellController::ExecutePlan(const v1::PickPlan& plan, int rank, Attempt& at
   RecordPlan(attempt.record, plan);
   const PlanPoses poses = PosesOf(plan, rank);
   const double opening_width = plan.grasp().opening_width();
-  attempt.record["grasp"] = GraspJson(poses.X_BinTcpGrasp, poses.approach_Bin, opening_width);
+  attempt.record["grasp"] =
+      GraspJson(poses.X_BinTcpGrasp, poses.approach_Bin, opening_width, plan.grasp().tilt());
   attempt.p_Bin_grasp = poses.X_BinTcpGrasp.translation();
 
   Approach(poses.X_BinTcpPreGrasp, opening_width, attempt);
@@ -264,10 +281,18 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
   devices::WrenchReading held = lifted;
+  const devices::RobotLimits limits = devices_.robot->Limits();
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
+    const v1::ResolutionMotion& motion = analysis.resolution_motions(m);
+    if (const std::optional<std::string> problem = ResolutionReachProblem(limits, motion, m, shift, state_)) {
+      spdlog::info("cell: round {}: resolution motion {} skipped, beyond the robot's limits at {}", round_, m,
+                   *problem);
+      resolution["beyond_limits"].push_back({{"motion", m}, {"problem", *problem}});
+      continue;
+    }
     resolution["used"] = m + 1;
     const v1::AnalyzeWrenchResponse again =
-        ResolutionMotion(analysis.resolution_motions(m), m, reference, shift, X_BinTcpHold, attempt, &held);
+        ResolutionMotion(motion, m, reference, shift, X_BinTcpHold, attempt, &held);
     if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
             Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))

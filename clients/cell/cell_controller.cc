@@ -381,7 +381,6 @@ CellController::Attempt& CellController::BeginAttempt(PlannedScan& scan, int ran
   attempt.record = BaseRecord(scan, rank, run.result.attempts);
   attempt.record["skipped_plans"] = std::exchange(scan.skipped, nlohmann::json::array());
   TakeVanishedOverWalls(scan, attempt.record);
-  run.touched.push_back(scan.response.plans(rank).tube_id());
   if (first_of_scan) {
     attempt.started = scan.started;
     attempt.device_started = scan.device_started;
@@ -408,6 +407,9 @@ CellController::AttemptResult CellController::FinishAttempt(RunState& run) {
   record["truth_after"] = Truth();
   if (const auto a = record.find("analysis"); a != record.end() && a->value("outcome", "") == "multiple")
     run.lifted_several = true;
+  // A grasp that closed on nothing took nothing: should its tube be gone from over a wall at the
+  // next scan, nothing the cell holds explains it.
+  if (outcome != AttemptResult::kGraspFailed) run.touched.push_back(record.value("tube", 0u));
   CountAttemptWrench(attempt, run.result);
   run.since_pick.push_back(DescribeAttemptBriefly(record));
   RememberFailedGrasp(outcome, attempt, run);

@@ -90,7 +90,7 @@ void DescribeFields(Visit& v, CellFrameCheckParams& c) {
 template <typename Visit>
 void DescribeFields(Visit& v, WallWatchParams& w) {
   v("enabled", w.enabled, "warn when a tube seen hanging over a wall is gone at the next scan");
-  v("below_top", w.below_top, "m: a tube's axis this close below the wall top or higher ...");
+  v("below_top", w.below_top, "m: a tube's top (axis + radius) this close below the wall top or higher ...");
   v("from_wall", w.from_wall, "m: ... and this close to the wall's inner face or past it hangs over it");
   v("gone_distance", w.gone_distance, "m: gone when the next scan has fewer than min_points this close");
   v("min_points", w.min_points, "(the wall's own points left out)");

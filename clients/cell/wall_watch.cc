@@ -14,11 +14,11 @@
 namespace tubepick::cell {
 namespace {
 
-/// The wall `p` hangs over, or nullopt.
-std::optional<std::string> WallAt(const Eigen::Vector3d& p, const BinConfig& bin,
+/// The wall a tube hangs over at its axis point `p` (its surface `radius` above), or nullopt.
+std::optional<std::string> WallAt(const Eigen::Vector3d& p, double radius, const BinConfig& bin,
                                   const WallWatchParams& params) {
   const Eigen::Vector3d& size = bin.inner_size;
-  if (p.z() < size.z() - params.below_top) return std::nullopt;
+  if (p.z() + radius < size.z() - params.below_top) return std::nullopt;
   const std::array<std::pair<double, const char*>, 4> walls = {{{p.x() - 0.5 * size.x(), "+x"},
                                                                 {-p.x() - 0.5 * size.x(), "-x"},
                                                                 {p.y() - 0.5 * size.y(), "+y"},
@@ -47,7 +47,7 @@ std::vector<TubeOverWall> TubesOverWalls(const v1::PlanPickResponse& response, c
     std::optional<TubeOverWall> highest;
     for (const v1::Cylinder& c : tube.cylinders()) {
       for (const Eigen::Vector3d& p : {FromProto(c.start()), FromProto(c.end())}) {
-        const std::optional<std::string> wall = WallAt(p, bin, params);
+        const std::optional<std::string> wall = WallAt(p, std::max(0.0, c.radius()), bin, params);
         if (!wall || (highest && highest->p_Bin.z() >= p.z())) continue;
         highest = TubeOverWall{tube.id(), p, *wall, scan};
       }

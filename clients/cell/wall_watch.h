@@ -16,13 +16,15 @@ namespace tubepick::cell {
 struct WallWatchParams {
   /// Off: nothing is watched.
   bool enabled = true;
-  /// A tube hangs over a wall where a point of its axis lies no lower than this below the wall top,
-  /// m, ...
+  /// A tube hangs over a wall where the top of its surface at a point of its axis (the axis point
+  /// raised by the cylinder's radius) lies no lower than this below the wall top, m, ...
   double below_top = 0.0;
-  /// ... and no farther than this inside the wall's inner face (or past it), m. With 3 cm each, in
-  /// ten simulated 20-tree bins two tubes leaning on a wall's inner face slid away unseen after a
-  /// pick (the warning said they might have fallen out); at 0 neither counted, and the one tree that
-  /// did fall out did (docs/ACCURACY.md, "Hard bins").
+  /// ... and the point no farther than this inside the wall's inner face (or past it), m. Wider
+  /// limits name more falls and warn more often for tubes that only slid inside the bin: on ten
+  /// simulated 20-tree bins (seeds 11-20, docs/ACCURACY.md "Hard bins"), where seed 14 lost three
+  /// trees together 1.8-3.5 cm from the walls, their tops 0.1-3 cm under the wall top, the limits
+  /// (0, 0) named none of them and warned once for a tree that stayed in the bin; (0.005, 0.02)
+  /// named them and warned 5 times; (0.02, 0.04) 9 times.
   double from_wall = 0.0;
   /// Gone when the next scan has fewer than `min_points` points within this of that point, m,
   /// leaving out the wall's own (its inner face and its top).
@@ -33,7 +35,7 @@ struct WallWatchParams {
   void Validate() const;
 };
 
-/// A tube a scan shows hanging over a bin wall: its axis reaches the wall's top at the wall. Such
+/// A tube a scan shows hanging over a bin wall: its top reaches the wall's top at the wall. Such
 /// a tube leans on the wall and on what lies under it; when that moves it can fall out of the bin,
 /// where no scan of the bin sees it (in a simulated 20-tree bin, a tree leaning on the -y wall fell
 /// over it when the tree it leaned on was picked).

@@ -114,7 +114,8 @@ std::array<OrientedBox, 2> FingerBoxes(const Grasp& grasp, const GraspFilterPara
   return boxes;
 }
 
-std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const GraspFilterParams& params) {
+std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const GraspFilterParams& params,
+                                      const GraspParams& grasps) {
   double lo = std::numeric_limits<double>::infinity();
   double hi = -lo;
   for (const Tube& tube : tubes) {
@@ -124,9 +125,12 @@ std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const Gras
     }
   }
   if (lo > hi) return {0.0, 0.0};
-  const double bottom = -params.finger_tip_depth;
+  const double tilt_reach =
+      std::sin(std::max(0.0, grasps.max_tilt)) * (0.5 * grasps.opening_width + params.finger_thickness);
+  const double bottom = -params.finger_tip_depth - tilt_reach;
   double top = params.finger_length - params.finger_tip_depth;
   if (params.approach_check) top = std::max(top, params.approach_column_height);
+  top += tilt_reach;
   // 1 mm slack against rounding at the band's edges.
   return {lo + bottom - 1e-3, hi + top + 1e-3};
 }

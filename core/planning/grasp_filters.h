@@ -91,9 +91,12 @@ std::array<OrientedBox, 2> FingerBoxes(const Grasp& grasp, const GraspFilterPara
 
 /// The z band [lo, hi] every finger box of a grasp on `tubes` lies in: a grasp point's z is
 /// between its cylinder's endpoint heights and the boxes span [G_z − finger_tip_depth,
-/// G_z − finger_tip_depth + finger_length] (the TCP z axis is vertical); with approach_check, up
+/// G_z − finger_tip_depth + finger_length] (a vertical TCP z axis); with approach_check, up
 /// to the approach columns' top (G_z + approach_column_height). Empty tubes ⇒ (0, 0).
-std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const GraspFilterParams& params);
+/// Tilted grasps (GraspParams::max_tilt) reach lower and higher by the pads' reach across the
+/// tube (half the opening plus a pad) times sin(max_tilt).
+std::pair<double, double> FingerBandZ(const std::vector<Tube>& tubes, const GraspFilterParams& params,
+                                      const GraspParams& grasps = GraspParams{});
 
 /// The columns the tool sweeps on its vertical approach to `grasp` (opened to its opening width):
 /// above each finger box (the pads, GraspFilterParams' finger size) and above the housing's bottom

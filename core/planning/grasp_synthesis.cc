@@ -23,6 +23,25 @@ std::optional<Eigen::Isometry3d> GraspFrame(const Eigen::Vector3d& p_Bin_grasp,
   return X_BinTcp;
 }
 
+Grasp TiltedGrasp(const Grasp& vertical, double tilt) {
+  Grasp g = vertical;
+  g.X_BinTcp.linear() =
+      vertical.X_BinTcp.linear() * Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  g.approach_Bin = g.X_BinTcp.linear().col(2);
+  g.tilt = vertical.tilt + tilt;
+  return g;
+}
+
+std::vector<double> GraspTilts(const GraspParams& params) {
+  std::vector<double> tilts;
+  if (!(params.max_tilt > 0.0) || !(params.tilt_step > 0.0)) return tilts;
+  for (int k = 1; k * params.tilt_step <= params.max_tilt + 1e-9; ++k) {
+    tilts.push_back(k * params.tilt_step);
+    tilts.push_back(-k * params.tilt_step);
+  }
+  return tilts;
+}
+
 std::vector<double> CylinderCurveOffsets(const Tube& tube) {
   std::vector<double> offsets(tube.cylinders.size(), 0.0);
   const std::vector<TubeNode> nodes = NodesOf(tube);

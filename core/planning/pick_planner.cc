@@ -34,12 +34,15 @@ double MaxHeight(const ModelingResult& modeling, const std::vector<Tube>& tubes)
   return top;
 }
 
-// Grasps of one tube, synthesized once, with the finger test cached (it does not depend on the
-// trajectory): -1 unknown, 0 clear, 1 fingers collide, 2 approach blocked.
+// Grasps of one tube, synthesized once, with the cloud tests cached (they do not depend on the
+// trajectory): -1 unknown, 0 clear, 1 fingers collide, 2 approach blocked. A vertical grasp's
+// tilted variants (GraspTilts order) are made the first time its tool touches a wall.
 struct TubeGrasps {
   bool synthesized = false;
   std::vector<Grasp> grasps;
   std::vector<std::int8_t> collides;
+  std::vector<std::vector<Grasp>> tilted;
+  std::vector<std::vector<std::int8_t>> tilted_collides;
 };
 
 // The cloud tests of a grasp: 1 when the fingers collide at the grasp pose (thesis filter (a)),
@@ -57,7 +60,12 @@ bool IsSure(const TubeClass& cls) { return cls.lying_on.empty() && !cls.too_shor
 struct Candidate {
   std::uint32_t trajectory = 0;  // index into the stage's trajectories
   std::uint32_t grasp = 0;       // index into TubeGrasps::grasps of the trajectory's tube
+  std::int32_t tilt = -1;        // index into TubeGrasps::tilted[grasp], -1: the vertical grasp
 };
+
+const Grasp& GraspOf(const TubeGrasps& tg, const Candidate& c) {
+  return c.tilt < 0 ? tg.grasps[c.grasp] : tg.tilted[c.grasp][c.tilt];
+}
 
 class StageTimer {
  public:
@@ -114,7 +122,26 @@ std::vector<Trajectory> StageTrajectories(const PlanningContext& ctx, Occlusion 
   return trajectories;
 }
 
-// The (trajectory, grasp) pairs that pass every filter (§5.2.4.1, the tool, the fingers).
+// The tilt (index into tg.tilted[gi]) of the smallest turn of grasp gi whose tool clears the bin
+// along `trajectory`, or -1.
+std::int32_t FirstClearTilt(const PlanningContext& ctx, TubeGrasps& tg, std::size_t gi,
+                            const Trajectory& trajectory) {
+  const PlanningParams& params = ctx.params;
+  if (tg.tilted[gi].empty()) {
+    for (const double tilt : GraspTilts(params.grasps))
+      tg.tilted[gi].push_back(TiltedGrasp(tg.grasps[gi], tilt));
+    tg.tilted_collides[gi].assign(tg.tilted[gi].size(), -1);
+  }
+  for (std::size_t k = 0; k < tg.tilted[gi].size(); ++k) {
+    const Grasp& g = tg.tilted[gi][k];
+    if (ToolClears(ctx.cell.bin, params.tool, g.X_BinTcp, g.opening_width, trajectory.waypoints))
+      return static_cast<std::int32_t>(k);
+  }
+  return -1;
+}
+
+// The (trajectory, grasp) pairs that pass every filter (§5.2.4.1, the tool, the fingers). Where
+// the vertical tool would touch a wall, the grasp's smallest tilt that clears it stands in.
 std::vector<Candidate> ViableCandidates(PlanningContext& ctx, const std::vector<Trajectory>& trajectories,
                                         const PickPlanResult& result, PlanningCounts& counts) {
   const PlanningParams& params = ctx.params;
@@ -126,9 +153,12 @@ std::vector<Candidate> ViableCandidates(PlanningContext& ctx, const std::vector<
     if (!tg.synthesized) {
       tg.grasps = SynthesizeGrasps(result.tubes[trajectory.tube_index], params.grasps);
       tg.collides.assign(tg.grasps.size(), -1);
+      tg.tilted.resize(tg.grasps.size());
+      tg.tilted_collides.resize(tg.grasps.size());
       tg.synthesized = true;
     }
     for (std::size_t gi = 0; gi < tg.grasps.size(); ++gi) {
+      Candidate candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi), -1};
       const Grasp& grasp = tg.grasps[gi];
       ++counts.grasp_candidates;
       if (!InAllowedSection(grasp, trajectory)) {
@@ -141,19 +171,24 @@ std::vector<Candidate> ViableCandidates(PlanningContext& ctx, const std::vector<
       }
       if (params.tool.check &&
           !ToolClears(ctx.cell.bin, params.tool, grasp.X_BinTcp, grasp.opening_width, trajectory.waypoints)) {
-        ++counts.rejected_tool;
-        continue;
+        candidate.tilt = FirstClearTilt(ctx, tg, gi, trajectory);
+        if (candidate.tilt < 0) {
+          ++counts.rejected_tool;
+          continue;
+        }
       }
-      if (tg.collides[gi] < 0) tg.collides[gi] = CloudCollision(grasp, *ctx.raw, params);
-      if (tg.collides[gi] == 1) {
+      std::int8_t& collides = candidate.tilt < 0 ? tg.collides[gi] : tg.tilted_collides[gi][candidate.tilt];
+      if (collides < 0) collides = CloudCollision(GraspOf(tg, candidate), *ctx.raw, params);
+      if (collides == 1) {
         ++counts.rejected_fingers;
         continue;
       }
-      if (tg.collides[gi] == 2) {
+      if (collides == 2) {
         ++counts.rejected_approach;
         continue;
       }
-      viable.push_back(Candidate{static_cast<std::uint32_t>(ti), static_cast<std::uint32_t>(gi)});
+      if (candidate.tilt >= 0) ++counts.tilted_grasps;
+      viable.push_back(candidate);
     }
   }
   return viable;
@@ -219,7 +254,7 @@ void PlanStage(PlanningContext& ctx, Occlusion stage, PickPlanResult* result, St
 
   if (!ctx.raw) {
     t0 = Clock::now();
-    const auto [z_lo, z_hi] = FingerBandZ(result->tubes, ctx.params.filters);
+    const auto [z_lo, z_hi] = FingerBandZ(result->tubes, ctx.params.filters, ctx.params.grasps);
     ctx.raw =
         std::make_unique<RawCloudIndex>(ctx.modeling.raw_Bin, ctx.params.filters.grid_cell_size, z_lo, z_hi);
     timer->Add("cloud_index", t0);
@@ -240,7 +275,7 @@ void PlanStage(PlanningContext& ctx, Occlusion stage, PickPlanResult* result, St
     const TubeClass& cls = result->classes[trajectory.tube_index];
     PickPlan plan;
     plan.tube_id = tube.id;
-    plan.grasp = ctx.tube_grasps[trajectory.tube_index].grasps[c.grasp];
+    plan.grasp = GraspOf(ctx.tube_grasps[trajectory.tube_index], c);
     plan.waypoints = trajectory.waypoints;
     plan.kind = trajectory.kind;
     plan.escape_direction = trajectory.escape_direction;
@@ -274,6 +309,8 @@ void PlanningParams::Validate() const {
   RequireNonNegative(g.min_base_distance, "planning.grasps.min_base_distance");
   RequirePositive(g.opening_width, "planning.grasps.opening_width");
   RequireInRange(g.max_axis_inclination, 0.0, M_PI / 2.0, "planning.grasps.max_axis_inclination");
+  RequireInRange(g.max_tilt, 0.0, M_PI / 3.0, "planning.grasps.max_tilt");
+  if (g.max_tilt > 0.0) RequireInRange(g.tilt_step, 1e-3, g.max_tilt, "planning.grasps.tilt_step");
 
   const GraspFilterParams& f = filters;
   RequirePositive(f.finger_thickness, "planning.filters.finger_thickness");

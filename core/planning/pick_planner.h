@@ -73,6 +73,8 @@ struct PlanningCounts {
   std::uint64_t rejected_tool = 0;
   std::uint64_t rejected_fingers = 0;
   std::uint64_t rejected_approach = 0;
+  /// Viable pairs whose grasp is tilted (GraspParams::max_tilt): the vertical tool touched a wall.
+  std::uint64_t tilted_grasps = 0;
   std::uint32_t plans = 0;
 };
 

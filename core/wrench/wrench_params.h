@@ -51,8 +51,10 @@ struct WrenchParams {
   /// (pointing down) uses (0, 0, -1). Normalised before use.
   Eigen::Vector3d up_Tcp = Eigen::Vector3d::UnitZ();
   /// Largest angle between up_Tcp (mapped to the bin by X_BinTcp) and the bin's +z accepted by the
-  /// resolution planner, radians; guards against a wrong up_Tcp or a tilted gripper.
-  double max_tilt = 15.0 * M_PI / 180.0;
+  /// resolution planner, radians; guards against a wrong up_Tcp or a gripper tilted more than a
+  /// grasp ever is (AnalyzeWrench: the TCP z axis from the vertical). At least
+  /// planning.grasps.max_tilt (30°): a grasp tilted away from a wall is lifted and analysed so.
+  double max_tilt = 35.0 * M_PI / 180.0;
   /// Resolution rotation angle, radians, in (0, π] (Table 5.3: 45°).
   double rotation_angle = M_PI / 4.0;
   /// Smallest |ΔM| (horizontal part) that defines a rotation axis, newton-metres; below it there

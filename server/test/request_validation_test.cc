@@ -376,10 +376,10 @@ std::vector<WrenchCase> WrenchCases() {
       {"TcpTilted",
        [](auto& r) {
          SetPose(r.mutable_tcp_pose(), {0, 0, 0.3},
-                 Eigen::Quaterniond(Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d::UnitY())) *
+                 Eigen::Quaterniond(Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitY())) *
                      GraspOrientation(0.0));
        },
-       {"tcp_pose.orientation", "30.0 deg", "max_tilt 15.0 deg", "vertical"}},
+       {"tcp_pose.orientation", "40.0 deg", "max_tilt 35.0 deg", "vertical"}},
       {"UnknownVariant",
        [](auto& r) { r.set_variant(static_cast<v1::ResolutionVariant>(9)); },
        {"variant", "9"}},

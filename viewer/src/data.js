@@ -151,7 +151,7 @@ function normPlan(p, index) {
   const g = p.grasp || {};
   return {
     index, tubeId: num(p.tubeId),
-    tcp: pose(g.tcpPose), approach: vec3(g.approach), openingWidth: num(g.openingWidth),
+    tcp: pose(g.tcpPose), approach: vec3(g.approach), openingWidth: num(g.openingWidth), tilt: num(g.tilt),
     waypoints: (p.waypoints || []).map(vec3), kind: kindName(p.trajectoryKind),
     cost: { H: num(p.cost?.height), C: num(p.cost?.centre), T: num(p.cost?.trajectory), G: num(p.cost?.total) },
     displacement: num(p.simulatedDisplacement), certainty: certaintyName(p.certainty),

@@ -53,6 +53,8 @@ export function planDetails(m, plan) {
   const rows = [
     ['grasp X_BinTcp', xyz(plan.tcp.p, 'grasp')],
     ['grasp yaw', el('b', { 'data-field': 'grasp-yaw' }, `${fmt(yawDeg(plan.tcp.q), 1)}°`)],
+    ['grasp tilt', el('b', { 'data-field': 'grasp-tilt' },
+      plan.tilt ? `${fmt(plan.tilt * 180 / Math.PI, 1)}° (a vertical tool would touch a wall)` : 'vertical')],
     ['finger opening', el('b', { 'data-field': 'opening' }, `${fmt(plan.openingWidth)} m`)],
     ['waypoints', waypointList(plan.waypoints)],
     ['place TCP', plan.place ? xyz(plan.place.p, 'place') : '–'],

@@ -113,7 +113,8 @@ function countsSection(m) {
     out.push(el('h2', {}, 'Candidates rejected per filter'), kvTable([
       ['grasp candidates', n('graspCandidates')], ['rejected: section', n('rejectedSection')],
       ['rejected: workspace', n('rejectedWorkspace')], ['rejected: tool', n('rejectedTool')],
-      ['rejected: fingers', n('rejectedFingers')], ['rejected: approach', n('rejectedApproach')]], 'counts'));
+      ['rejected: fingers', n('rejectedFingers')], ['rejected: approach', n('rejectedApproach')],
+      ['viable with a tilted tool', n('tiltedGrasps')]], 'counts'));
     out.push(el('h2', {}, 'Tubes and trajectories'), kvTable([
       ['tubes', n('tubes')], ['too short', c.shortTubesPlanned ? `${n('tooShort')}, every one: planned as a last resort` : n('tooShort')], ['non-occluded', n('nonOccluded')],
       ['weakly occluded', n('weaklyOccluded')], ['strongly occluded', n('stronglyOccluded')],

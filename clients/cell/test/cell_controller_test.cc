@@ -582,6 +582,34 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(a["result"], "multiple_returned");
 }
 
+TEST_F(CellControllerTest, AResolutionMotionBeyondTheWristLimitIsSkippedNotDriven) {
+  // The first motion turns the tool 0.7 rad past a 0.5 rad wrist limit (a tool tilted at the
+  // grasp, turned further); the second stays within it and frees a tube.
+  robot.limits.max_tilt = 0.5;
+  params.resolution_hold_over_bin = false;  // turns about the lift pose itself
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
+  const Eigen::Isometry3d X_BinTcpFar = X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d X_BinTcpNear = X_BinTcpLift * Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitY());
+  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
+  AddWaypoint(multiple, 0, X_BinTcpFar);
+  AddWaypoint(multiple, 1, X_BinTcpNear);
+  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_FALSE(robot.Visited(X_BinTcpFar));
+  EXPECT_TRUE(robot.Visited(X_BinTcpNear));
+  EXPECT_EQ(planner.wrench_requests.size(), 2u);
+  const json a = Records("attempt").at(0);
+  ASSERT_EQ(a["resolution"]["beyond_limits"].size(), 1u);
+  EXPECT_EQ(a["resolution"]["beyond_limits"][0]["motion"], 0);
+  EXPECT_THAT(a["resolution"]["beyond_limits"][0]["problem"].get<std::string>(),
+              ::testing::HasSubstr("waypoint 0: "));
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+}
+
 /// The reading of a payload of `weight` newtons hanging at r_Bin (horizontal, bin frame) from a TCP
 /// at orientation R_BinTcp, in the sensor's (TCP) axes, the empty tool reading zero.
 devices::WrenchReading PayloadReading(const Eigen::Matrix3d& R_BinTcp, double weight,
@@ -1801,6 +1829,25 @@ TEST_F(WallWatchTest, ATubeOverAWallThatAnAttemptTookIsNotMissed) {
   EXPECT_EQ(result.picks, 1u) << result.message;
   EXPECT_TRUE(result.vanished_over_walls.empty());
   EXPECT_EQ(DescribeRoundWarnings(result), "");
+}
+
+TEST_F(WallWatchTest, ATubeOverAWallThatAGraspClosedOnNothingDidNotTakeIsNamedWhenGone) {
+  // Scan 0 plans tube 7 itself, along the -y wall and over its top: the grasp closes on nothing;
+  // scan 1 (the bin empty) no longer shows it. In seed 14's 20-tree bin a grasp that closed on
+  // nothing pressed the heap and three trees fell over the walls.
+  auto first = Plans({MakePlan(7, {-0.15, -0.285, 0.17})}, 0);
+  AddTubeAxis(first.response, 7, {{-0.25, -0.28, 0.15}, {-0.05, -0.29, 0.19}, {0.0, -0.305, 0.21}});
+  planner.plan_answers = {first};
+  params.check_tool_clearance = false;
+  gripper.close_results = {ClosedOnNothing()};
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  const std::vector<json> attempts = Records("attempt");
+  ASSERT_EQ(attempts.size(), 1u);
+  EXPECT_EQ(attempts[0]["result"], "grasp_failed");
+  ASSERT_EQ(result.vanished_over_walls.size(), 1u);
+  EXPECT_EQ(result.vanished_over_walls[0],
+            "over the -y wall at (0.000, -0.305, 0.210) m, not seen again after scan 0");
 }
 
 // ---------------------------------------------------------------- the safe stop's descent

@@ -17,28 +17,39 @@ using testing::AddTubeAxis;
 // The thesis bin: 0.8 x 0.6 m inside, walls 0.2 m high.
 const BinConfig kBin;
 
-TEST(WallWatch, ATubeRisingOverTheWallTopHangsOverIt) {
-  v1::PlanPickResponse scan;
+TEST(WallWatch, ATubeWhoseTopReachesTheWallTopAtTheWallHangsOverIt) {
+  v1::PlanPickResponse scan;  // every cylinder 1 cm in radius
   AddTubeAxis(scan, 7, {{-0.08, -0.10, 0.11}, {-0.065, -0.226, 0.183}, {-0.029, -0.304, 0.22}});
   AddTubeAxis(scan, 3, {{0.36, 0.0, 0.02}, {0.385, 0.1, 0.02}});  // on the floor along the +x wall
   AddTubeAxis(scan, 5, {{0.0, 0.0, 0.25}, {0.1, 0.0, 0.25}});     // high, in the middle
   AddTubeAxis(scan, 9, {{0.2, 0.0, 0.1}, {0.39, 0.2, 0.205}});    // 1 cm inside the +x wall's face
-  AddTubeAxis(scan, 11, {{0.2, 0.0, 0.1}, {0.41, 0.2, 0.19}});    // past it, 1 cm below its top
+  AddTubeAxis(scan, 11, {{0.2, 0.0, 0.1}, {0.41, 0.2, 0.185}});   // past it, its top 0.5 cm below
   AddTubeAxis(scan, 12, {{0.2, 0.1, 0.1}, {0.405, 0.2, 0.201}});  // past it, above its top
+  // Seed 14's trees before they fell: top 1 mm under the wall top 1.8 cm from the -y wall's face,
+  // and 1.7 cm under it 2.7 cm from the +x wall's.
+  AddTubeAxis(scan, 13, {{0.1, -0.2, 0.12}, {0.211, -0.282, 0.189}});
+  AddTubeAxis(scan, 14, {{0.2, -0.149, 0.12}, {0.373, -0.149, 0.173}});
+  AddTubeAxis(scan, 15, {{0.0, 0.2, 0.12}, {0.0, 0.25, 0.21}});    // 5 cm from the +y wall
+  AddTubeAxis(scan, 16, {{-0.2, 0.0, 0.1}, {-0.37, 0.0, 0.165}});  // 3 cm from -x, its top 2.5 cm under
+  AddTubeAxis(scan, 17,
+              {{-0.2, 0.1, 0.1}, {-0.41, 0.1, 0.195}});  // past -x, its axis under the top, its top over
   const std::vector<TubeOverWall> over = TubesOverWalls(scan, kBin, 5, WallWatchParams{});
-  ASSERT_EQ(over.size(), 2u);
-  EXPECT_EQ(over[0].tube_id, 7u);
+  std::vector<std::uint32_t> ids;
+  for (const TubeOverWall& t : over) ids.push_back(t.tube_id);
+  // By default only tops at or above the wall top, at or past its inner face.
+  EXPECT_THAT(ids, ::testing::ElementsAre(7u, 12u, 17u));
   EXPECT_EQ(over[0].wall, "-y");
   EXPECT_TRUE(over[0].p_Bin.isApprox(Eigen::Vector3d(-0.029, -0.304, 0.22)));
   EXPECT_EQ(over[0].scan, 5u);
   EXPECT_EQ(Describe(over[0]), "over the -y wall at (-0.029, -0.304, 0.220) m, not seen again after scan 5");
-  EXPECT_EQ(over[1].tube_id, 12u);
   EXPECT_EQ(over[1].wall, "+x");
-  // Leaning on the inner face within 3 cm of its top counts when the limits say so.
+  // Within 2 cm of the top and 4 cm of the face: tubes leaning on a wall, seed 14's among them.
   WallWatchParams wide;
-  wide.below_top = 0.03;
-  wide.from_wall = 0.03;
-  EXPECT_EQ(TubesOverWalls(scan, kBin, 5, wide).size(), 4u);
+  wide.below_top = 0.02;
+  wide.from_wall = 0.04;
+  ids.clear();
+  for (const TubeOverWall& t : TubesOverWalls(scan, kBin, 5, wide)) ids.push_back(t.tube_id);
+  EXPECT_THAT(ids, ::testing::ElementsAre(7u, 9u, 11u, 12u, 13u, 14u, 17u));
 }
 
 /// A capture of `points_Bin` by the default sensor (1.1 m above the floor, looking down), in `unit`.

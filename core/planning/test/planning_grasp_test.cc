@@ -265,12 +265,18 @@ TEST(GraspFilters, FingerBandDropsFloorAndKeepsVerdicts) {
   GraspFilterParams params;
   params.approach_check = false;
   const std::vector<Tube> tubes = {MakeTube(0, {FlatCylinder(-0.2, 0.0, 0.2, 0.0, 1)})};
-  const auto [lo, hi] = FingerBandZ(tubes, params);
+  GraspParams vertical;
+  vertical.max_tilt = 0.0;
+  const auto [lo, hi] = FingerBandZ(tubes, params, vertical);
   EXPECT_NEAR(lo, kR - 0.005 - 0.001, kTol);
   EXPECT_NEAR(hi, kR - 0.005 + 0.05 + 0.001, kTol);
+  // Tilted grasps (30° by default) reach lower and higher by sin 30° · (0.045 / 2 + 0.01).
+  const auto [lo_tilted, hi_tilted] = FingerBandZ(tubes, params);
+  EXPECT_NEAR(lo_tilted, lo - 0.01625, kTol);
+  EXPECT_NEAR(hi_tilted, hi + 0.01625, kTol);
   // With the approach check the band reaches the approach columns' top.
   params.approach_check = true;
-  const auto [lo_approach, hi_approach] = FingerBandZ(tubes, params);
+  const auto [lo_approach, hi_approach] = FingerBandZ(tubes, params, vertical);
   EXPECT_NEAR(lo_approach, lo, kTol);
   EXPECT_NEAR(hi_approach, kR + 0.5 + 0.001, kTol);
   Points pts = TubeAndFloor();

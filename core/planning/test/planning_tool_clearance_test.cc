@@ -106,12 +106,15 @@ TEST(ToolClearance, PlannerRejectsEveryGraspOfATubeAlongAWall) {
 }
 
 TEST(ToolClearance, PlannerFallsThroughToAnOccludedTube) {
-  // Tube 0 lies on top along x, 0.05 m from the −y wall (non-occluded, no executable grasp);
-  // tube 1 runs along y under it (split at the crossing: weakly occluded) into the middle.
+  // Tube 0 lies on top along x, 0.05 m from the −y wall (non-occluded, no executable grasp for a
+  // vertical tool); tube 1 runs along y under it (split at the crossing: weakly occluded) into the
+  // middle.
   const std::vector<Tube> tubes = {
       MakeTube(0, {FlatCylinder(-0.2, -0.25, 0.2, -0.25, 7, 3.0 * kR)}),
       MakeTube(1, {FlatCylinder(0.0, -0.29, 0.0, -0.27, 1), FlatCylinder(0.0, -0.23, 0.0, 0.15, 2)})};
-  const PickPlanResult r = PlanPick(Model(tubes), CellConfig{}, PlanningParams{}, nullptr, 1);
+  PlanningParams vertical;
+  vertical.grasps.max_tilt = 0.0;
+  const PickPlanResult r = PlanPick(Model(tubes), CellConfig{}, vertical, nullptr, 1);
   ASSERT_EQ(r.classes.size(), 2u);
   EXPECT_EQ(r.tubes[0].occlusion, Occlusion::kNone);
   EXPECT_EQ(r.tubes[1].occlusion, Occlusion::kWeak);
@@ -125,12 +128,73 @@ TEST(ToolClearance, PlannerFallsThroughToAnOccludedTube) {
   EXPECT_GE(r.counts.rejected_tool, 19u);  // every grasp of tube 0
 
   // Without the check the planner stops at tube 0 (stage 1), whose grasps the tool cannot execute.
-  PlanningParams off;
+  PlanningParams off = vertical;
   off.tool.check = false;
   const PickPlanResult o = PlanPick(Model(tubes), CellConfig{}, off, nullptr, 1);
   EXPECT_EQ(o.planned_class, Occlusion::kNone);
   ASSERT_FALSE(o.plans.empty());
   EXPECT_EQ(o.plans.front().tube_id, 0u);
+
+  // With tilted grasps (the default) tube 0 is grasped after all, first: 5 cm from the wall the
+  // housing clears when the tool turns 15° (its near bottom corner 4.6 cm from the axis).
+  const PickPlanResult t = PlanPick(Model(tubes), CellConfig{}, PlanningParams{}, nullptr, 1);
+  EXPECT_EQ(t.planned_class, Occlusion::kNone);
+  ASSERT_FALSE(t.plans.empty());
+  EXPECT_EQ(t.plans.front().tube_id, 0u);
+  EXPECT_NEAR(std::abs(t.plans.front().grasp.tilt), M_PI / 12, 1e-12);
+}
+
+TEST(ToolClearance, TiltsTurnTheToolAboutTheTubeBothWaysSmallestFirst) {
+  GraspParams params;  // 15° steps up to 30°
+  EXPECT_THAT(GraspTilts(params), ::testing::ElementsAre(::testing::DoubleNear(M_PI / 12, 1e-12),
+                                                         ::testing::DoubleNear(-M_PI / 12, 1e-12),
+                                                         ::testing::DoubleNear(M_PI / 6, 1e-12),
+                                                         ::testing::DoubleNear(-M_PI / 6, 1e-12)));
+  params.max_tilt = 0.0;
+  EXPECT_TRUE(GraspTilts(params).empty());
+
+  Grasp vertical;
+  vertical.X_BinTcp = AcrossX(0.1, 0.2, 0.05);
+  vertical.p_Bin_grasp = vertical.X_BinTcp.translation();
+  const Grasp tilted = TiltedGrasp(vertical, 0.3);
+  EXPECT_DOUBLE_EQ(tilted.tilt, 0.3);
+  EXPECT_TRUE(tilted.X_BinTcp.translation().isApprox(vertical.X_BinTcp.translation()));
+  EXPECT_TRUE(tilted.X_BinTcp.linear().col(0).isApprox(Eigen::Vector3d::UnitX()));  // across the tube still
+  EXPECT_TRUE(tilted.approach_Bin.isApprox(tilted.X_BinTcp.linear().col(2)));
+  EXPECT_NEAR(tilted.approach_Bin.z(), -std::cos(0.3), 1e-12);
+  EXPECT_NEAR(std::abs(tilted.approach_Bin.y()), std::sin(0.3), 1e-12);
+}
+
+TEST(ToolClearance, ATubeAlongAWallIsGraspedWithTheToolTiltedAwayFromIt) {
+  // Seed 12's last tree (2026-12-05): along the +y wall, its axis 3.9 cm from the wall, 5.6 cm up.
+  // A vertical tool's housing (0.068 m from the axis with the margin) would be 2.9 cm into the
+  // wall; turned 15° still 1.0 cm; turned 30° it clears, and the lower pad stays 3.5 cm above
+  // the floor.
+  const ModelingResult wall = Model({MakeTube(0, {FlatCylinder(-0.2, 0.261, 0.2, 0.261, 1, 0.056)})});
+  PlanningParams vertical;
+  vertical.grasps.max_tilt = 0.0;
+  const PickPlanResult v = PlanPick(wall, CellConfig{}, vertical, nullptr, 1);
+  EXPECT_TRUE(v.plans.empty());
+  EXPECT_EQ(v.counts.rejected_tool, 19u);
+
+  const PickPlanResult r = PlanPick(wall, CellConfig{}, PlanningParams{}, nullptr, 1);
+  ASSERT_EQ(r.plans.size(), 19u);
+  EXPECT_EQ(r.counts.rejected_tool, 0u);
+  EXPECT_EQ(r.counts.tilted_grasps, 19u);
+  for (const PickPlan& p : r.plans) {
+    EXPECT_NEAR(std::abs(p.grasp.tilt), M_PI / 6, 1e-12);
+    // The approach runs down towards the wall: the tool's top leans away from it.
+    EXPECT_NEAR(p.grasp.approach_Bin.y(), 0.5, 1e-9);
+    EXPECT_TRUE(p.grasp.approach_Bin.isApprox(p.grasp.X_BinTcp.linear().col(2)));
+    EXPECT_TRUE(
+        ToolClears(CellConfig{}.bin, ToolParams{}, p.grasp.X_BinTcp, p.grasp.opening_width, p.waypoints));
+  }
+
+  // On the floor the same tube keeps no grasp: turned, the lower pad would dig into the floor.
+  const ModelingResult low = Model({MakeTube(0, {FlatCylinder(-0.2, 0.261, 0.2, 0.261, 1)})});
+  const PickPlanResult f = PlanPick(low, CellConfig{}, PlanningParams{}, nullptr, 1);
+  EXPECT_TRUE(f.plans.empty());
+  EXPECT_EQ(f.counts.rejected_tool, 19u);
 }
 
 TEST(ToolClearance, ParamsSectionReadsWritesAndValidates) {
@@ -152,6 +216,13 @@ TEST(ToolClearance, ParamsSectionReadsWritesAndValidates) {
     FAIL() << "negative margin accepted";
   } catch (const InvalidArgument& e) {
     EXPECT_THAT(e.what(), HasSubstr("planning.tool.margin"));
+  }
+  try {
+    ParseParams("planning:\n  grasps:\n    max_tilt: 1.2\n", base);
+    FAIL() << "a tilt beyond 60 degrees accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("planning.grasps.max_tilt"));
+    EXPECT_THAT(e.what(), HasSubstr("1.2"));
   }
   try {
     ParseParams("planning:\n  tool:\n    pad_size: 0.01\n", base);
