@@ -224,6 +224,13 @@ TEST(ToolClearance, ParamsSectionReadsWritesAndValidates) {
     EXPECT_THAT(e.what(), HasSubstr("planning.grasps.max_tilt"));
     EXPECT_THAT(e.what(), HasSubstr("1.2"));
   }
+  try {  // 40°: within the grasps' range, beyond what AnalyzeWrench accepts (35°)
+    ParseParams("planning:\n  grasps:\n    max_tilt: 0.7\n", base);
+    FAIL() << "a grasp tilt beyond wrench.max_tilt accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("planning.grasps.max_tilt: 0.7"));
+    EXPECT_THAT(e.what(), HasSubstr("wrench.max_tilt 0.61"));
+  }
   try {
     ParseParams("planning:\n  tool:\n    pad_size: 0.01\n", base);
     FAIL() << "unknown key accepted";
