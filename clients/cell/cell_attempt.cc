@@ -300,7 +300,7 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   }
   const Eigen::Isometry3d X_BinTcpPutBack = PutBackPose(reference, held, X_BinTcpLift, attempt);
   if (!X_BinTcpPutBack.isApprox(X_BinTcpHold)) MoveTo(X_BinTcpPutBack, params_.lift_speed, &attempt);
-  PutBack(poses.X_BinTcpGrasp, X_BinTcpLift, X_BinTcpPutBack, reference, attempt);
+  PutBack(poses.X_BinTcpGrasp, X_BinTcpPutBack, reference, attempt);
   return AttemptResult::kMultipleReturned;
 }
 
@@ -474,26 +474,20 @@ void CellController::ReleaseEmpty(Attempt& attempt) {
   GoHome(&attempt);
 }
 
-void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
-                             const Eigen::Isometry3d& X_BinTcpPutBack,
+void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpPutBack,
                              const devices::WrenchReading& reference, Attempt& attempt) {
   Enter(CellState::kReturnToBin);
-  // Down to just above the grasp height, open, and back up. At the lift pose (its xy checked against
-  // the bin's safety zone by the planner) the tubes go down the way they came up, in one move;
-  // further inside, the heap under them is unknown: in F/T-read steps (LayDown).
+  // Down towards just above the grasp height in F/T-read steps (LayDown), open where they rest, and
+  // back up. Also at the lift pose: what hangs under the tube grasped came up from elsewhere and was
+  // turned by the resolution, so the heap meets it before the grasp height (lowered there in one
+  // move, a tangle of two trees was pushed on down through the heap and one went over a wall).
   Eigen::Isometry3d X_BinTcpRelease = X_BinTcpPutBack;
   X_BinTcpRelease.translation().z() =
       std::min(X_BinTcpPutBack.translation().z(), X_BinTcpGrasp.translation().z() + params_.release_height);
-  const bool moved_inward = !X_BinTcpPutBack.translation().isApprox(X_BinTcpLift.translation(), 1e-9);
-  const double drop = X_BinTcpRelease.translation().z() - X_BinTcpPutBack.translation().z();
-  Eigen::Isometry3d X_BinTcpOpen = X_BinTcpRelease;
-  if (moved_inward) {
-    X_BinTcpOpen = LayDown(X_BinTcpPutBack, X_BinTcpRelease, reference, attempt);
-  } else if (drop < 0.0) {
-    MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, drop)}, params_.lift_speed, &attempt);
-  }
+  const Eigen::Isometry3d X_BinTcpOpen = LayDown(X_BinTcpPutBack, X_BinTcpRelease, reference, attempt);
   OpenGripper();
-  if (drop < 0.0) MoveTo(X_BinTcpPutBack, params_.approach_speed, &attempt);
+  if (X_BinTcpOpen.translation().z() < X_BinTcpPutBack.translation().z() - detail::kSameHeight)
+    MoveTo(X_BinTcpPutBack, params_.approach_speed, &attempt);
   CheckToolEmpty(reference, "after_put_back", X_BinTcpOpen, attempt);
   GoHome(&attempt);
 }

@@ -455,11 +455,10 @@ class CellController {
   void RecordLost(const TubeLost& lost, Attempt& attempt);
   void ReleaseEmpty(Attempt& attempt);
   /// Several tubes held after every resolution motion, the TCP at X_BinTcpPutBack (PutBackPose):
-  /// lower them to release_height above the grasp's height (at the lift pose in one move, further
-  /// inside in steps: LayDown), open, back up.
-  void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpLift,
-               const Eigen::Isometry3d& X_BinTcpPutBack, const devices::WrenchReading& reference,
-               Attempt& attempt);
+  /// lower them towards release_height above the grasp's height in steps (LayDown), open where they
+  /// rest, back up.
+  void PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen::Isometry3d& X_BinTcpPutBack,
+               const devices::WrenchReading& reference, Attempt& attempt);
   /// From X_BinTcpFrom (where the TCP is) straight down to X_BinTcpRelease in steps of put_back_step, reading
   /// the F/T after each; stops where less than half a tube's weight still hangs on the tool (the tubes rest
   /// on the heap); readings that disagree (a tangle swinging, sliding on the heap) go on down. Returns where

@@ -62,12 +62,14 @@ struct CellControllerParams {
   /// down over it (a simulated 20-tree bin lost two trees so, its centre of mass 1 cm inside).
   /// Metres.
   double put_back_margin = 0.15;
-  /// Moved inward, where the heap under them is unknown, the put-back's way down goes in steps of
-  /// at most this (at the lift pose: one move, the way they came up), reading the F/T after each;
-  /// where the tubes rest (less than half a tube's weight still hangs on the tool), the gripper
-  /// opens there; readings that disagree (a tangle swinging or sliding on the heap) go on down.
-  /// Lowered all the way, not let go at the first contact: a tangle dropped as soon as one arm
-  /// touched a low heap threw a tree onto a wall's top. 0 = one move. Metres.
+  /// The put-back's way down goes in steps of at most this, reading the F/T after each: where the
+  /// tubes rest (less than half a tube's weight still hangs on the tool), the gripper opens there;
+  /// readings that disagree (a tangle swinging or sliding on the heap) go on down. Also at the lift
+  /// pose: what hangs under the tube grasped came up from elsewhere, and lowered in one move to the
+  /// grasp height it was pushed on through the heap (a simulated 20-tree bin lost a tree over a
+  /// wall so). Lowered until the heap takes the load, not let go at the first contact: a tangle
+  /// dropped as soon as one arm touched a low heap threw a tree onto a wall's top. 0 = one move.
+  /// Metres.
   double put_back_step = 0.02;
   /// Safe stop while holding a tube: the TCP goes over the bin's middle and down to this height
   /// above the bin floor before the gripper opens (below the wall top: the tube falls inside),

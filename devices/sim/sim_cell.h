@@ -80,8 +80,10 @@ struct SimGripperParams {
   double finger_tip_depth = 0.005;
   /// The gripper housing: a box of this size (x, y, z in the TCP frame, metres; 0 = none) whose
   /// bottom is housing_gap above the pads' top (the fingertips reach 75 mm below it). It pushes
-  /// tubes like the pads do. Keep it equal to the controller's tool model
-  /// (clients/cell/tool_clearance.h ToolGeometry), which plans around it.
+  /// tubes like the pads do. With a housing, each finger goes on up to it (its linkage: a box of
+  /// the pad's width and thickness over the gap, part of the pad's body, not of its gripping
+  /// face), so no tube wedges between a pad's top and the housing. Keep it equal to the controller's tool
+  /// model (clients/cell/tool_clearance.h ToolGeometry), which plans around it.
   Eigen::Vector3d housing_size{0.06, 0.13, 0.09};
   double housing_gap = 0.02;
   /// Finger speed range (rate of change of the opening), m/s; requests are clamped into it.

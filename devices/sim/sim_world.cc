@@ -118,6 +118,23 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
       btVector3(0.5 * g.finger_width, 0.5 * g.finger_thickness, 0.5 * g.finger_length));
   pad->setMargin(0.001);
   world_->shapes.push_back(std::move(pad));
+  if (hand_->getCollisionShape()->getShapeType() == COMPOUND_SHAPE_PROXYTYPE && g.housing_gap > 0.0) {
+    // The finger's linkage: from the pad's top up to the housing, as on the 2F-85. Without it a
+    // tube could wedge in the open slot between a pad's top and the housing and hang on the open
+    // tool (seen: 600-800 N of contact in a simulated 20-tree bin), where the real fingers leave
+    // no room.
+    btCollisionShape* pad_shape = world_->shapes.back().get();
+    auto linkage = std::make_unique<btBoxShape>(
+        btVector3(0.5 * g.finger_width, 0.5 * g.finger_thickness, 0.5 * g.housing_gap));
+    linkage->setMargin(0.001);
+    auto finger = std::make_unique<btCompoundShape>();
+    finger->addChildShape(btTransform::getIdentity(), pad_shape);
+    finger->addChildShape(
+        btTransform(btQuaternion::getIdentity(), btVector3(0, 0, -0.5 * (g.finger_length + g.housing_gap))),
+        linkage.get());
+    world_->shapes.push_back(std::move(linkage));
+    world_->shapes.push_back(std::move(finger));
+  }
   for (btRigidBody*& p : pads_) p = add_kinematic(world_->shapes.back().get());
 
   X_BinTcp_ = params_.robot.X_BinTcp_start;
@@ -264,6 +281,7 @@ PadContacts SimWorld::QueryPads() const {
   PadContacts out;
   std::set<LinkId> links;
   const Eigen::Vector3d y_Bin = X_BinTcp_.linear().col(1);
+  const double pad_top_z = params_.gripper.finger_tip_depth - params_.gripper.finger_length;
   btDispatcher& dispatcher = *world_->world->getDispatcher();
   for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
     const btPersistentManifold& m = *dispatcher.getManifoldByIndexInternal(i);
@@ -278,6 +296,11 @@ PadContacts SimWorld::QueryPads() const {
       const btManifoldPoint& cp = m.getContactPoint(k);
       if (cp.getDistance() > kTouchDistance) continue;
       if (std::abs(FromBt(cp.m_normalWorldOnB).dot(y_Bin)) < kInnerFaceCos) continue;
+      // The pad's face, not the linkage above it.
+      const Eigen::Vector3d p_Tcp =
+          X_BinTcp_.inverse() *
+          FromBt(pad == GripperPart(m.getBody0()) ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB());
+      if (p_Tcp.z() < pad_top_z - kTouchDistance) continue;
       out.touching[pad] = true;
       out.force[pad] += cp.m_appliedImpulse / substep_;
       links.insert({static_cast<std::size_t>(other->getUserIndex()),

@@ -554,6 +554,9 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   AddWaypoint(multiple, 1, X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
   planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0),
                             Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9)};
+  ft.held_force = 2.0 * 1.08;  // two tubes' weight hangs on the tool ...
+  ft.tcp = &robot.X_BinTcp;
+  ft.rests_below_z = 0.25;  // ... until the heap takes it
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
@@ -561,15 +564,33 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(result.scans, 2u);
   EXPECT_EQ(planner.wrench_requests.size(), 3u);
   // Its centre of mass well inside the walls (no torque): lowered where it was lifted, straight down
-  // in one move (the way it came up) to release_height above the grasp point, opened, back up.
-  const Eigen::Vector3d p_Bin_release = p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height);
-  bool lowered = false;
-  for (const testing::ScriptedRobot::Move& m : robot.moves)
-    if (m.through && m.X_BinTcpTarget.isApprox(DownPose(p_Bin_release), kTol)) lowered = true;
-  EXPECT_TRUE(lowered);
-  EXPECT_FALSE(robot.Visited(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4 - params.put_back_step))));
-  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(),
-                          [&](const Eigen::Vector3d& p) { return p.isApprox(p_Bin_release, kTol); }));
+  // in put_back_step steps reading the F/T (what hangs under the tube grasped meets the heap before
+  // the grasp height), opened where the heap takes the load (0.25 m up here), back up.
+  std::vector<double> stops;
+  for (const testing::ScriptedRobot::Move& m : robot.moves) {
+    const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+    if ((q.head<2>() - p_Bin_grasp.head<2>()).norm() < kTol && q.z() > 0.2 && q.z() < 0.43 + kTol)
+      stops.push_back(q.z());
+  }
+  // (The resolution's turns and the way back from them stop at the lift height too: from the last.)
+  while (stops.size() > 1 && std::abs(stops[1] - 0.43) < kTol) stops.erase(stops.begin());
+  // The lift pose, equal steps of at most put_back_step towards the release height (0.37 m in 19)
+  // down to the first at or below 0.25 m (the 10th, at 0.235 m), back up.
+  const double release_z = p_Bin_grasp.z() + params.release_height;
+  const int steps = static_cast<int>(std::ceil((0.43 - release_z) / params.put_back_step - 1e-9));
+  const double step = (0.43 - release_z) / steps;
+  const double z_open = 0.43 - step * std::ceil((0.43 - 0.25) / step - 1e-9);
+  ASSERT_EQ(stops.size(), static_cast<std::size_t>(std::lround((0.43 - z_open) / step)) + 2);
+  EXPECT_NEAR(stops.front(), 0.43, kTol);
+  EXPECT_NEAR(stops[1], 0.43 - step, kTol);
+  EXPECT_NEAR(stops[stops.size() - 2], z_open, kTol);
+  EXPECT_LT(z_open, 0.25);
+  EXPECT_GT(z_open, 0.25 - step);
+  EXPECT_NEAR(stops.back(), 0.43, kTol);
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(), [&](const Eigen::Vector3d& p) {
+    return p.isApprox(Eigen::Vector3d(p_Bin_grasp.x(), p_Bin_grasp.y(), z_open), kTol);
+  }));
+  EXPECT_FALSE(robot.Visited(DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, params.release_height))));
   EXPECT_FALSE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   EXPECT_TRUE(gripper.open);
 
@@ -578,7 +599,8 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(a["resolution"]["succeeded"], false);
   EXPECT_EQ(a["wrench"]["after_resolution"].size(), 2u);
   EXPECT_EQ(a["resolution"]["put_back_shift"], json::array({0.0, 0.0}));
-  EXPECT_FALSE(a.contains("put_back_touchdown"));
+  EXPECT_NEAR(a["put_back_touchdown"]["above_release"].get<double>(),
+              z_open - (p_Bin_grasp.z() + params.release_height), 1e-9);
   EXPECT_EQ(a["result"], "multiple_returned");
 }
 

@@ -122,14 +122,12 @@ void PutBackSeveral(SimCell& cell, const TrialGrasp& grasp, const Wrench& refere
   Eigen::Isometry3d X_BinTcpRelease = X_BinTcpPutBack;
   X_BinTcpRelease.translation().z() = grasp.X_BinTcp.translation().z() + c.release_height;
   const double resting = 0.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
-  if (!shift.isZero()) {
-    for (const Eigen::Isometry3d& X_BinTcpStep :
-         cell::DescentSteps(c.put_back_step, X_BinTcpPutBack, X_BinTcpRelease)) {
-      cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
-      if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight < resting) {
-        X_BinTcpRelease = X_BinTcpStep;
-        break;
-      }
+  for (const Eigen::Isometry3d& X_BinTcpStep :
+       cell::DescentSteps(c.put_back_step, X_BinTcpPutBack, X_BinTcpRelease)) {
+    cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
+    if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight < resting) {
+      X_BinTcpRelease = X_BinTcpStep;
+      break;
     }
   }
   cell.robot().MoveTo(X_BinTcpRelease, c.lift_speed, kLong);
@@ -483,7 +481,7 @@ void AddResolutionTrialsCommand(CLI::App& app) {
                   "Tubes not freed: their centre of mass at least this inside the walls, metres")
       ->capture_default_str();
   cmd->add_option("--put-back-step", o->trial.controller.put_back_step,
-                  "... and, moved inside, lowered in steps of this, metres (0 = one move)")
+                  "... and lowered in steps of this, metres (0 = one move)")
       ->capture_default_str();
   cmd->add_option("--max-lifts", o->trial.max_lifts, "Lifts per bin until one holds several tubes")
       ->check(CLI::Range(1, 100))

@@ -235,6 +235,38 @@ TEST(SimCell, ASnaggedTubeStaysOnTheOpenToolUntilItOpensAgain) {
   EXPECT_EQ(cell.fault_events().snags, 1u);  // armed once: the second opening let go
 }
 
+TEST(SimCell, TheFingersReachTheHousingSoNoTubeWedgesAboveAPad) {
+  // A thin tube lies across the tops of the ±x walls of a low, narrow bin, at the height of the
+  // 20 mm between the pads' tops and the housing. The open tool comes at it sideways at that
+  // height: a finger's linkage meets it and pushes it along (the real 2F-85 has no open slot
+  // there; without the linkage the tube passed through under the housing untouched, and in a
+  // heap such a tube wedged there and hung on the open tool).
+  SimCellParams params;
+  params.cell.bin.inner_size = Eigen::Vector3d(0.40, 0.60, 0.08);
+  const double radius = 0.008;
+  const double z = params.cell.bin.inner_size.z() + radius;
+  SimCell cell(params, {PolylineTube(1, {{-0.25, 0.0, z}, {0.0, 0.0, z}, {0.25, 0.0, z}}, radius)});
+  ASSERT_EQ(cell.TubesBin().size(), 1u);
+  const double y_before = cell.TubeCentresOfMass()[0].y();
+  cell.robot().ServoOn(kLong);
+  cell.gripper().Activate(kLong);
+  cell.gripper().Open(kLong);
+  const SimGripperParams& g = params.gripper;
+  const double slot_middle = -(g.finger_tip_depth - g.finger_length - 0.5 * g.housing_gap);  // above the TCP
+  Eigen::Isometry3d X = SimRobotParams::DefaultStart();
+  X.translation() = Eigen::Vector3d(0.0, -0.15, 0.3);
+  cell.robot().MoveTo(X, 0.25, kLong);
+  X.translation().z() = z - slot_middle;
+  cell.robot().MoveTo(X, 0.25, kLong);
+  EXPECT_NEAR(cell.TubeCentresOfMass()[0].y(), y_before, 1e-3);  // not touched on the way down
+  X.translation().y() = 0.10;
+  cell.robot().MoveTo(X, 0.05, kLong);
+  cell.Advance(0.5);
+  // Pushed along by the leading finger's linkage (pad 1, 47.5 mm from the TCP towards +y_Bin): met at
+  // TCP y ≈ −0.06 m, the tube ends about 0.16 m from where it lay.
+  EXPECT_GT(cell.TubeCentresOfMass()[0].y() - y_before, 0.10);
+}
+
 TEST(SimCell, TubeDroppedBesideThePlaceZoneCountsAsElsewhere) {
   SimCellParams params;
   SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
