@@ -102,7 +102,8 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
     body->setUserIndex(kGripperUserIndex);
     return body;
   };
-  if ((g.housing_size.array() > 0.0).all()) {
+  const bool housing = (g.housing_size.array() > 0.0).all();
+  if (housing) {
     auto box = std::make_unique<btBoxShape>(ToBt(0.5 * g.housing_size));
     box->setMargin(0.001);
     auto compound = std::make_unique<btCompoundShape>();
@@ -118,7 +119,7 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
       btVector3(0.5 * g.finger_width, 0.5 * g.finger_thickness, 0.5 * g.finger_length));
   pad->setMargin(0.001);
   world_->shapes.push_back(std::move(pad));
-  if (hand_->getCollisionShape()->getShapeType() == COMPOUND_SHAPE_PROXYTYPE && g.housing_gap > 0.0) {
+  if (housing && g.housing_gap > 0.0) {
     // The finger's linkage: from the pad's top up to the housing, as on the 2F-85. Without it a
     // tube could wedge in the open slot between a pad's top and the housing and hang on the open
     // tool (seen: 600-800 N of contact in a simulated 20-tree bin), where the real fingers leave
@@ -281,13 +282,15 @@ PadContacts SimWorld::QueryPads() const {
   PadContacts out;
   std::set<LinkId> links;
   const Eigen::Vector3d y_Bin = X_BinTcp_.linear().col(1);
+  const Eigen::Isometry3d X_TcpBin = X_BinTcp_.inverse();
   const double pad_top_z = params_.gripper.finger_tip_depth - params_.gripper.finger_length;
   btDispatcher& dispatcher = *world_->world->getDispatcher();
   for (int i = 0; i < dispatcher.getNumManifolds(); ++i) {
     const btPersistentManifold& m = *dispatcher.getManifoldByIndexInternal(i);
     int pad = GripperPart(m.getBody0());
     const btCollisionObject* other = m.getBody1();
-    if (pad < 0 || pad > 1) {
+    const bool pad_is_body0 = pad == 0 || pad == 1;
+    if (!pad_is_body0) {
       pad = GripperPart(m.getBody1());
       other = m.getBody0();
     }
@@ -298,8 +301,7 @@ PadContacts SimWorld::QueryPads() const {
       if (std::abs(FromBt(cp.m_normalWorldOnB).dot(y_Bin)) < kInnerFaceCos) continue;
       // The pad's face, not the linkage above it.
       const Eigen::Vector3d p_Tcp =
-          X_BinTcp_.inverse() *
-          FromBt(pad == GripperPart(m.getBody0()) ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB());
+          X_TcpBin * FromBt(pad_is_body0 ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB());
       if (p_Tcp.z() < pad_top_z - kTouchDistance) continue;
       out.touching[pad] = true;
       out.force[pad] += cp.m_appliedImpulse / substep_;

@@ -90,6 +90,17 @@ class CellControllerTest : public ::testing::Test {
   /// The controller of the Run / DryRun under way (for an observer that asks it to stop).
   CellController* running = nullptr;
   const Eigen::Vector3d p_Bin_grasp{0.1, -0.05, 0.03};
+  /// The heights, in order, of the robot's stops above `p_xy` between z_min and z_max (a put-back's
+  /// way down and back up; home's transit lies higher).
+  std::vector<double> StopsOver(const Eigen::Vector3d& p_xy, double z_min, double z_max) const {
+    std::vector<double> z;
+    for (const auto& m : robot.moves) {
+      const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
+      if ((q.head<2>() - p_xy.head<2>()).norm() < kTol && q.z() > z_min && q.z() < z_max + kTol)
+        z.push_back(q.z());
+    }
+    return z;
+  }
   /// The i-th of several grasps 4 cm apart (a 5 x 2 grid from p_Bin_grasp): a failed grasp's spot is
   /// not planned again (failed_grasp_radius), so scripted retries grasp elsewhere.
   Eigen::Vector3d GraspSpot(int i) const {
@@ -566,12 +577,7 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   // Its centre of mass well inside the walls (no torque): lowered where it was lifted, straight down
   // in put_back_step steps reading the F/T (what hangs under the tube grasped meets the heap before
   // the grasp height), opened where the heap takes the load (0.25 m up here), back up.
-  std::vector<double> stops;
-  for (const testing::ScriptedRobot::Move& m : robot.moves) {
-    const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
-    if ((q.head<2>() - p_Bin_grasp.head<2>()).norm() < kTol && q.z() > 0.2 && q.z() < 0.43 + kTol)
-      stops.push_back(q.z());
-  }
+  std::vector<double> stops = StopsOver(p_Bin_grasp, 0.2, 0.43);
   // (The resolution's turns and the way back from them stop at the lift height too: from the last.)
   while (stops.size() > 1 && std::abs(stops[1] - 0.43) < kTol) stops.erase(stops.begin());
   // The lift pose, equal steps of at most put_back_step towards the release height (0.37 m in 19)
@@ -700,14 +706,7 @@ class PutBackInsideTest : public CellControllerTest {
   const Eigen::Vector3d p_Bin_release{0.16, -0.05, 0.03 + params.release_height};
   const double top = 0.43;
   /// The put-back's stops at (0.16, -0.05), in order, up to the lift height (not home's transit).
-  std::vector<double> Stops() const {
-    std::vector<double> z;
-    for (const auto& m : robot.moves) {
-      const Eigen::Vector3d q = m.X_BinTcpTarget.translation();
-      if ((q.head<2>() - p_Bin_release.head<2>()).norm() < kTol && q.z() < top + kTol) z.push_back(q.z());
-    }
-    return z;
-  }
+  std::vector<double> Stops() const { return StopsOver(p_Bin_release, -1.0, top); }
 };
 
 TEST_F(PutBackInsideTest, TubesAreLetGoWhereTheyRestOnTheHeapNotPressedIntoIt) {
