@@ -220,6 +220,28 @@ void ValidateTubeGraph(const Tube& tube, const std::string& name) {
     }
     if (!used[n]) throw InvalidArgument(name + ".nodes[" + std::to_string(n) + "]: no branch uses it");
   }
+  // One tree: every node reached from node 0, and one branch fewer than nodes (no cycle).
+  std::vector<bool> reached(tube.nodes.size(), false);
+  reached[0] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const TubeBranch& b : tube.branches) {
+      if (reached[b.from_node] != reached[b.to_node]) {
+        reached[b.from_node] = reached[b.to_node] = true;
+        grew = true;
+      }
+    }
+  }
+  const auto apart = std::find(reached.begin(), reached.end(), false);
+  if (apart != reached.end()) {
+    throw InvalidArgument(name + ": nodes 0 and " + std::to_string(apart - reached.begin()) +
+                          " are not joined by any path of branches (a tube is one tree)");
+  }
+  if (tube.branches.size() + 1 != tube.nodes.size()) {
+    throw InvalidArgument(name + ": has " + std::to_string(tube.branches.size()) + " branches for " +
+                          std::to_string(tube.nodes.size()) +
+                          " nodes, so a cycle (a tree of N nodes has N - 1 branches)");
+  }
 }
 
 }  // namespace tubepick

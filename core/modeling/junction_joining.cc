@@ -14,7 +14,8 @@
 //    (a cylinder or a joint of it), at least min_angle off it and not within node_spacing of
 //    that chain's free ends. A tube lying across another is not one: its axis passes about two
 //    radii above the other's. The chain is cut there (the cylinder under the node is split at
-//    the foot; T-nodes closer than node_spacing on one chain share a node).
+//    the foot; T-nodes closer than node_spacing on one chain, or with no cylinder between them,
+//    share a node).
 // 3. Links: two ends that met alone in step 1 and lie within link_max_distance and link_max_angle
 //    (α + β, as the linear joining) are joined end to end (the node is then dropped again,
 //    WithoutPassThroughNodes).
@@ -69,6 +70,23 @@ Eigen::Vector3d PointAtArc(const std::vector<AxisPiece>& pieces, double arc) {
     arc -= length;
   }
   return pieces.back().b;
+}
+
+// Where a cut at `position` on a chain's axis pieces falls between two of its cylinders (on a
+// joint, or within kMinPiece of a cylinder's start or end, where TreeBuilder moves the cut): the
+// number of cylinders before it; nullopt inside a cylinder. Two T-nodes at one boundary have no
+// cylinder between them for a branch, so they are one node.
+std::optional<std::size_t> CylinderBoundaryAt(const std::vector<AxisPiece>& pieces, double position) {
+  const auto k = std::min(static_cast<std::size_t>(position), pieces.size() - 1);
+  std::size_t before = 0;
+  for (std::size_t i = 0; i < k; ++i) before += pieces[i].cylinder >= 0 ? 1 : 0;
+  const AxisPiece& piece = pieces[k];
+  if (piece.cylinder < 0) return before;
+  const double length = (piece.b - piece.a).norm();
+  const double t = position - static_cast<double>(k);
+  if (t * length < kMinPiece) return before;
+  if ((1.0 - t) * length < kMinPiece) return before + 1;
+  return std::nullopt;
 }
 
 // Where the arms of a T-junction's run are measured: this far from the node along the run.
@@ -341,8 +359,11 @@ class Acceptance {
     if (max_length > 0.0 && forest_.Length(j.branch) + forest_.Length(j.host) + link > max_length)
       return false;
     std::vector<HostNode>& nodes = out_.nodes_of_host[j.host];
+    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains_[j.host]);
+    const std::optional<std::size_t> boundary = CylinderBoundaryAt(pieces, j.host_position);
     auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
-      return std::abs(n.arc - j.host_arc) < params_.node_spacing;
+      return std::abs(n.arc - j.host_arc) < params_.node_spacing ||
+             (boundary && CylinderBoundaryAt(pieces, n.position) == boundary);
     });
     const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
     if (near != nodes.end() && near->degree + 1 > max_branches) return false;

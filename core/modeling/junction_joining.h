@@ -72,7 +72,8 @@ struct JunctionParams {
   /// against another's side) 40° or more off; 55° gave the most correct tubes (docs/ACCURACY.md).
   double shape_tolerance = 55.0 * 3.14159265358979323846 / 180.0;
   /// A junction closer than this to the other chain's free end is not one (that would be an end
-  /// to end join), and junctions closer than this on one chain become one node, metres.
+  /// to end join), and junctions closer than this on one chain become one node, metres (as do
+  /// junctions with no cylinder between them: both on one joint of the chain).
   double node_spacing = 0.02;
   /// Where junctions are looked for, the linear joining before them is held to these limits
   /// (modeling.joining's own when smaller): joining arms end to end across a Y-piece (a 60°

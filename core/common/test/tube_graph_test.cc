@@ -110,5 +110,23 @@ TEST(TubeGraph, ValidationNamesTheBadField) {
               ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("1 nodes but no branches")));
 }
 
+TEST(TubeGraph, ValidationRefusesATubeThatIsNotOneTree) {
+  // Two pieces with no branch between them (node 3 hangs on a loop of its own).
+  Tube t = TeeTube();
+  t.branches[1] = TubeBranch{1, 0, 1, 1};
+  t.branches[2] = TubeBranch{2, 3, 2, 1};
+  EXPECT_THAT([&] { ValidateTubeGraph(t, "tubes[1]"); },
+              ::testing::ThrowsMessage<InvalidArgument>(
+                  HasSubstr("tubes[1]: nodes 0 and 2 are not joined by any path of branches")));
+  // A cycle: the branch's end linked back to the trunk's end by a fourth branch.
+  t = TeeTube();
+  t.cylinders.push_back(Cyl({0.10, 0.13, kR}, {0.20, 0, kR}, 2));
+  t.branches.push_back(TubeBranch{3, 2, 3, 1});
+  EXPECT_THAT(
+      [&] { ValidateTubeGraph(t, "t"); },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("t: has 4 branches for 4 nodes, so a cycle")));
+  EXPECT_NO_THROW(ValidateTubeGraph(TeeTube(), "t"));
+}
+
 }  // namespace
 }  // namespace tubepick
