@@ -175,6 +175,8 @@ void DescribeFields(Visit& v, JunctionParams& p) {
   v("link_max_angle", p.link_max_angle, "two free ends meeting alone: linked within this α + β, radians");
   v("max_tube_length", p.max_tube_length);
   v("max_length_share", p.max_length_share, "with tube.length known, no tree longer than this share of it");
+  v("layout_tolerance", p.layout_tolerance,
+    "with tube.junctions, junction_spacing or branch_length known: runs within this of them, m");
   v("auto_min_junctions", p.auto_min_junctions,
     "topology auto: junctions a scene needs to count as branched");
   v("auto_min_per_tube", p.auto_min_per_tube, "topology auto: and this many per tube they leave");

@@ -168,6 +168,15 @@ CellConfig ValidateCell(const v1::CellDescription* cell, const PlanningDefaults&
   out.tube.topology = TopologyOf(cell->tube_topology(), defaults.cell.tube.topology, f + "tube_topology");
   out.tube.junction_shape = JunctionShapeOf(cell->tube_junction_shape(), defaults.cell.tube.junction_shape,
                                             f + "tube_junction_shape");
+  if (cell->tube_junctions() > JunctionLayout::kMaxJunctions) {
+    throw InvalidArgument(f + "tube_junctions: " + std::to_string(cell->tube_junctions()) + " is above " +
+                          std::to_string(JunctionLayout::kMaxJunctions) + " (junctions of one part)");
+  }
+  out.tube.layout.junctions = cell->tube_junctions();
+  RequireRange(cell->tube_junction_spacing(), 0.0, kMaxTubeLength, false, f + "tube_junction_spacing", "m");
+  out.tube.layout.junction_spacing = cell->tube_junction_spacing();
+  RequireRange(cell->tube_branch_length(), 0.0, kMaxTubeLength, false, f + "tube_branch_length", "m");
+  out.tube.layout.branch_length = cell->tube_branch_length();
 
   if (!cell->has_place_pose()) throw InvalidArgument(f + "place_pose: required when the cell is given");
   out.place.X_BinPlace = FromProto(cell->place_pose(), f + "place_pose");

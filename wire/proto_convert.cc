@@ -252,6 +252,9 @@ v1::CellDescription ToCellDescription(const CellConfig& cell, const Eigen::Isome
   out.set_tube_mass(cell.tube.mass);
   out.set_tube_topology(ToProto(cell.tube.topology));
   out.set_tube_junction_shape(ToProto(cell.tube.junction_shape));
+  out.set_tube_junctions(cell.tube.layout.junctions);
+  out.set_tube_junction_spacing(cell.tube.layout.junction_spacing);
+  out.set_tube_branch_length(cell.tube.layout.branch_length);
   *out.mutable_place_pose() = ToProto(cell.place.X_BinPlace);
   return out;
 }

@@ -1,6 +1,7 @@
 #include "core/common/cell_config.h"
 
 #include <cmath>
+#include <utility>
 
 #include "core/common/cell_config_fields.h"
 #include "core/common/config_fields.h"
@@ -65,6 +66,23 @@ Eigen::Isometry3d SensorConfig::DefaultX_BinSensor() {
   return X;
 }
 
+void JunctionLayout::Validate(const std::string& prefix, double tube_length) const {
+  if (junctions > kMaxJunctions) {
+    throw InvalidArgument(prefix + ".junctions: " + std::to_string(junctions) + " is above " +
+                          std::to_string(kMaxJunctions) + " (junctions of one part)");
+  }
+  for (const auto& [key, value] : {std::pair<const char*, double>{"junction_spacing", junction_spacing},
+                                   std::pair<const char*, double>{"branch_length", branch_length}}) {
+    const std::string field = prefix + "." + key;
+    RequireInRange(value, 0.0, 10.0, field);
+    if (tube_length > 0.0 && value >= tube_length) {
+      throw InvalidArgument(field + ": " + FormatNumber(value) + " m is not shorter than the tube (" +
+                            FormatNumber(tube_length) + " m" +
+                            "): a run of a part is part of its length (millimetres given as metres?)");
+    }
+  }
+}
+
 void CellConfig::Validate() const {
   for (int i = 0; i < 3; ++i) {
     RequireInRange(bin.inner_size[i], 0.01, 10.0, "bin.inner_size[" + std::to_string(i) + "]");
@@ -78,6 +96,7 @@ void CellConfig::Validate() const {
   RequireInRange(tube.radius, 0.001, 0.2, "tube.radius");
   RequireInRange(tube.length, 0.0, 10.0, "tube.length");
   RequireInRange(tube.mass, 0.001, 50.0, "tube.mass");
+  tube.layout.Validate("tube", tube.length);
   if (!place.X_BinPlace.matrix().allFinite()) throw InvalidArgument("place.pose_in_bin: non-finite pose");
 }
 

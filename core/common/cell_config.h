@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -65,6 +66,29 @@ std::string ToString(JunctionShape shape);
 /// @throws InvalidArgument naming `field`, the value and the accepted ones.
 JunctionShape ParseJunctionShape(const std::string& text, const std::string& field);
 
+/// Branched tubes: what the part's drawing says of its junctions; 0 = not known. Junction
+/// joining refuses a tree the drawing rules out (JunctionParams::layout_tolerance): two junctions
+/// joined by a run of another length than junction_spacing, or more junctions than the part has,
+/// counting one hidden past each junction's arm that ends longer than branch_length. Set C: 2
+/// junctions 0.30 m apart (the trunk), branches of 0.10–0.15 m.
+struct JunctionLayout {
+  /// Junctions of one part.
+  std::uint32_t junctions = 0;
+  /// Length of the run between two adjacent junctions, along its axis, metres.
+  double junction_spacing = 0.0;
+  /// Longest run from a junction to a free end, metres.
+  double branch_length = 0.0;
+
+  /// Most junctions a part may be said to have.
+  static constexpr std::uint32_t kMaxJunctions = 64;
+
+  /// Whether any of it is known.
+  bool known() const { return junctions > 0 || junction_spacing > 0.0 || branch_length > 0.0; }
+  /// @throws InvalidArgument naming "<prefix>.<key>" and the value; runs must be shorter than a
+  /// known `tube_length` (0 = unknown).
+  void Validate(const std::string& prefix, double tube_length) const;
+};
+
 struct TubeConfig {
   /// Tube radius, metres.
   double radius = 0.0125;
@@ -78,6 +102,8 @@ struct TubeConfig {
   TubeTopology topology = TubeTopology::kLinear;
   /// Branched tubes: the fitting at their junctions.
   JunctionShape junction_shape = JunctionShape::kAny;
+  /// Branched tubes: where their junctions are (fields junctions, junction_spacing, branch_length).
+  JunctionLayout layout;
 };
 
 /// Where placed tubes go: X_BinPlace is the destination frame the tube's PCA frame is aligned

@@ -34,6 +34,11 @@ void DescribeFields(Visit& v, TubeConfig& tube) {
   v.Enum(
       "junction_shape", tube.junction_shape, [](JunctionShape s) { return ToString(s); }, ParseJunctionShape,
       "Branched tubes: any, wye (arms 120 deg apart) or tee (a run and a branch at 90 deg).");
+  v("junctions", tube.layout.junctions, "Branched tubes: junctions of one part (its drawing); 0 = unknown.");
+  v("junction_spacing", tube.layout.junction_spacing,
+    "Branched tubes: run between two adjacent junctions along its axis, m; 0 = unknown.");
+  v("branch_length", tube.layout.branch_length,
+    "Branched tubes: longest run from a junction to a free end, m; 0 = unknown.");
 }
 
 template <typename Visit>

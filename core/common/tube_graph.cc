@@ -177,6 +177,17 @@ Eigen::Vector3d TubeMassCentre(const Tube& tube) {
   return weighted / total;
 }
 
+std::vector<double> BranchLengths(const Tube& tube) {
+  const std::vector<TubeBranch> branches = BranchesOf(tube);
+  std::vector<double> out(branches.size(), 0.0);
+  for (std::size_t b = 0; b < branches.size(); ++b) {
+    for (std::uint32_t k = 0; k < branches[b].cylinder_count; ++k)
+      out[b] += tube.cylinders[branches[b].first_cylinder + k].length();
+  }
+  for (const TubeJoint& joint : TubeJoints(tube)) out[joint.branch] += joint.length();
+  return out;
+}
+
 void ValidateTubeGraph(const Tube& tube, const std::string& name) {
   for (std::size_t c = 0; c < tube.cylinders.size(); ++c) {
     const Cylinder& cyl = tube.cylinders[c];

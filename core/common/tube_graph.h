@@ -68,6 +68,10 @@ struct AxisPiece {
 /// linear tube: cylinder 0, joint 0, cylinder 1, ...
 std::vector<AxisPiece> TubeAxisPieces(const Tube& tube);
 
+/// Length of each branch's axis (BranchesOf order): its cylinders, the joints between them and
+/// its links to its nodes (TubeJoints).
+std::vector<double> BranchLengths(const Tube& tube);
+
 /// Length-weighted centre of the tube's axis (cylinders and joints): the mass centre of a tube of
 /// uniform section. @pre the tube has a cylinder of non-zero length.
 Eigen::Vector3d TubeMassCentre(const Tube& tube);

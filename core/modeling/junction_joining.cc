@@ -320,134 +320,6 @@ std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<T
   return best;
 }
 
-// Accepts nodes one by one while every tube stays a tree (union-find over chains), each free
-// end is used once, no node exceeds its branches and no tube the given length.
-class Acceptance {
- public:
-  Acceptance(const std::vector<Tube>& chains, const JunctionParams& params, JunctionShape shape)
-      : chains_(chains), params_(params), shape_(shape), forest_(chains), end_used_(chains.size()) {}
-
-  // A Y-piece (three or more ends) or a link (two).
-  bool Meeting(const MeetingNode& meeting, double max_length) {
-    const std::optional<MeetingNode> fitting =
-        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains_, shape_, params_.shape_tolerance) : meeting;
-    if (!fitting) return false;
-    const MeetingNode& n = *fitting;
-    std::vector<std::uint32_t> roots;
-    double links = 0.0;
-    for (const auto& [chain, at_end] : n.ends) {
-      if (Used(chain, at_end)) return false;
-      roots.push_back(forest_.Find(chain));
-      links += (FreeEndOf(chains_[chain], at_end).p - n.Centre()).norm();
-    }
-    std::sort(roots.begin(), roots.end());
-    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return false;  // a cycle
-    double length = links;
-    for (const std::uint32_t r : roots) length += forest_.Length(r);
-    if (max_length > 0.0 && length > max_length) return false;
-    for (std::size_t k = 1; k < n.ends.size(); ++k) forest_.Unite(n.ends[0].first, n.ends[k].first, 0.0);
-    forest_.AddLength(n.ends[0].first, links);
-    for (const auto& [chain, at_end] : n.ends) Use(chain, at_end);
-    out_.meetings.push_back(n);
-    return true;
-  }
-
-  // A T-piece: the branch's free end on the host's side.
-  bool Side(const Junction& j, double max_length) {
-    if (Used(j.branch, j.at_end) || forest_.Find(j.branch) == forest_.Find(j.host)) return false;
-    const double link = (j.p_Bin - FreeEndOf(chains_[j.branch], j.at_end).p).norm();
-    if (max_length > 0.0 && forest_.Length(j.branch) + forest_.Length(j.host) + link > max_length)
-      return false;
-    std::vector<HostNode>& nodes = out_.nodes_of_host[j.host];
-    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains_[j.host]);
-    const std::optional<std::size_t> boundary = CylinderBoundaryAt(pieces, j.host_position);
-    auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
-      return std::abs(n.arc - j.host_arc) < params_.node_spacing ||
-             (boundary && CylinderBoundaryAt(pieces, n.position) == boundary);
-    });
-    const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
-    if (near != nodes.end() && near->degree + 1 > max_branches) return false;
-    if (near == nodes.end()) {
-      nodes.push_back(HostNode{j.host_arc, j.host_position, j.p_Bin, 2});
-      near = nodes.end() - 1;
-    }
-    ++near->degree;
-    Use(j.branch, j.at_end);
-    forest_.Unite(j.branch, j.host, link);
-    out_.junctions.push_back(j);
-    out_.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
-    return true;
-  }
-
-  Accepted Take() && { return std::move(out_); }
-
- private:
-  bool Used(std::uint32_t chain, bool at_end) const { return end_used_[chain][at_end ? 1 : 0]; }
-  void Use(std::uint32_t chain, bool at_end) { end_used_[chain][at_end ? 1 : 0] = true; }
-
-  const std::vector<Tube>& chains_;
-  const JunctionParams& params_;
-  JunctionShape shape_;
-  Forest forest_;
-  std::vector<std::array<bool, 2>> end_used_;
-  Accepted out_;
-};
-
-// What the completion may still accept: T-pieces and pairs of ends within its wider limits.
-struct CompletionCandidates {
-  std::vector<Junction> sides;
-  std::vector<EndMeeting> pairs;
-};
-
-// Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
-// first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
-// completion's candidates, cheapest first across both kinds.
-Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
-                const std::vector<Junction>& candidates, const CompletionCandidates& completion,
-                double max_length, double max_completed_length, const JunctionParams& params,
-                JunctionShape shape, const StopToken* stop) {
-  Acceptance acceptance(chains, params, shape);
-  for (const MeetingNode& n : meeting_nodes) {
-    const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
-    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length);
-  }
-  for (const Junction& j : candidates) {
-    ThrowIfStopped(stop, "joining");
-    acceptance.Side(j, max_length);
-  }
-  for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() == 2) acceptance.Meeting(n, max_length);
-  }
-  std::uint32_t completed_sides = 0, completed_links = 0;
-  if (max_completed_length > 0.0) {
-    std::size_t s = 0, m = 0;
-    const auto& sides = completion.sides;
-    const auto& pairs = completion.pairs;
-    while (s < sides.size() || m < pairs.size()) {
-      ThrowIfStopped(stop, "joining");
-      if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
-        completed_sides += acceptance.Side(sides[s++], max_completed_length) ? 1 : 0;
-      } else {
-        const EndMeeting& pair = pairs[m++];
-        completed_links +=
-            acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true}, max_completed_length) ? 1 : 0;
-      }
-    }
-  }
-  Accepted out = std::move(acceptance).Take();
-  out.completed_sides = completed_sides;
-  out.completed_links = completed_links;
-  return out;
-}
-
-// The longest tree joining may build (0 = no limit): max_tube_length, and with the cell's tube
-// length known, max_length_share of it.
-double MaxTreeLength(const JunctionParams& params, double tube_length) {
-  if (!(tube_length > 0.0)) return params.max_tube_length;
-  const double share = params.max_length_share * tube_length;
-  return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
-}
-
 // Builds one tree from the chains of a component and the junctions among them.
 class TreeBuilder {
  public:
@@ -562,6 +434,172 @@ class TreeBuilder {
   std::uint32_t first_ = 0;
 };
 
+// Accepts nodes one by one while every tube stays a tree (union-find over chains), each free
+// end is used once, no node exceeds its branches, no tube the given length and, with the part's
+// junction layout known, every tree fits it (FitsJunctionLayout).
+class Acceptance {
+ public:
+  Acceptance(const std::vector<Tube>& chains, const JunctionParams& params, JunctionShape shape,
+             const JunctionLayout& layout)
+      : chains_(chains),
+        params_(params),
+        shape_(shape),
+        layout_(layout),
+        state_{Forest(chains), std::vector<std::array<bool, 2>>(chains.size()), {}} {}
+
+  // A Y-piece (three or more ends) or a link (two).
+  bool Meeting(const MeetingNode& meeting, double max_length) {
+    return Fitting([&] { return AcceptMeeting(meeting, max_length); }, meeting.ends.front().first);
+  }
+
+  bool Side(const Junction& j, double max_length) {
+    return Fitting([&] { return AcceptSide(j, max_length); }, j.branch);
+  }
+
+  Accepted Take() && { return std::move(state_.out); }
+
+ private:
+  struct State {
+    Forest forest;
+    std::vector<std::array<bool, 2>> end_used;
+    Accepted out;
+  };
+
+  // Accepts with `accept`, then takes it back unless the tree holding `chain` fits the layout.
+  template <typename Accept>
+  bool Fitting(Accept accept, std::uint32_t chain) {
+    if (!layout_.known()) return accept();
+    State before = state_;
+    if (!accept()) return false;
+    const std::uint32_t root = state_.forest.Find(chain);
+    std::vector<std::uint32_t> members;
+    for (std::uint32_t c = 0; c < chains_.size(); ++c) {
+      if (state_.forest.Find(c) == root) members.push_back(c);
+    }
+    if (FitsJunctionLayout(TreeBuilder(chains_, state_.out).Build(members), layout_,
+                           params_.layout_tolerance))
+      return true;
+    state_ = std::move(before);
+    return false;
+  }
+
+  bool AcceptMeeting(const MeetingNode& meeting, double max_length) {
+    const std::optional<MeetingNode> fitting =
+        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains_, shape_, params_.shape_tolerance) : meeting;
+    if (!fitting) return false;
+    const MeetingNode& n = *fitting;
+    std::vector<std::uint32_t> roots;
+    double links = 0.0;
+    for (const auto& [chain, at_end] : n.ends) {
+      if (Used(chain, at_end)) return false;
+      roots.push_back(state_.forest.Find(chain));
+      links += (FreeEndOf(chains_[chain], at_end).p - n.Centre()).norm();
+    }
+    std::sort(roots.begin(), roots.end());
+    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return false;  // a cycle
+    double length = links;
+    for (const std::uint32_t r : roots) length += state_.forest.Length(r);
+    if (max_length > 0.0 && length > max_length) return false;
+    for (std::size_t k = 1; k < n.ends.size(); ++k)
+      state_.forest.Unite(n.ends[0].first, n.ends[k].first, 0.0);
+    state_.forest.AddLength(n.ends[0].first, links);
+    for (const auto& [chain, at_end] : n.ends) Use(chain, at_end);
+    state_.out.meetings.push_back(n);
+    return true;
+  }
+
+  // A T-piece: the branch's free end on the host's side.
+  bool AcceptSide(const Junction& j, double max_length) {
+    if (Used(j.branch, j.at_end) || state_.forest.Find(j.branch) == state_.forest.Find(j.host)) return false;
+    const double link = (j.p_Bin - FreeEndOf(chains_[j.branch], j.at_end).p).norm();
+    if (max_length > 0.0 && state_.forest.Length(j.branch) + state_.forest.Length(j.host) + link > max_length)
+      return false;
+    std::vector<HostNode>& nodes = state_.out.nodes_of_host[j.host];
+    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains_[j.host]);
+    const std::optional<std::size_t> boundary = CylinderBoundaryAt(pieces, j.host_position);
+    auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
+      return std::abs(n.arc - j.host_arc) < params_.node_spacing ||
+             (boundary && CylinderBoundaryAt(pieces, n.position) == boundary);
+    });
+    const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
+    if (near != nodes.end() && near->degree + 1 > max_branches) return false;
+    if (near == nodes.end()) {
+      nodes.push_back(HostNode{j.host_arc, j.host_position, j.p_Bin, 2});
+      near = nodes.end() - 1;
+    }
+    ++near->degree;
+    Use(j.branch, j.at_end);
+    state_.forest.Unite(j.branch, j.host, link);
+    state_.out.junctions.push_back(j);
+    state_.out.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
+    return true;
+  }
+
+  bool Used(std::uint32_t chain, bool at_end) const { return state_.end_used[chain][at_end ? 1 : 0]; }
+  void Use(std::uint32_t chain, bool at_end) { state_.end_used[chain][at_end ? 1 : 0] = true; }
+
+  const std::vector<Tube>& chains_;
+  const JunctionParams& params_;
+  JunctionShape shape_;
+  const JunctionLayout& layout_;
+  State state_;
+};
+
+// What the completion may still accept: T-pieces and pairs of ends within its wider limits.
+struct CompletionCandidates {
+  std::vector<Junction> sides;
+  std::vector<EndMeeting> pairs;
+};
+
+// Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
+// first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
+// completion's candidates, cheapest first across both kinds.
+Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
+                const std::vector<Junction>& candidates, const CompletionCandidates& completion,
+                double max_length, double max_completed_length, const JunctionParams& params,
+                JunctionShape shape, const JunctionLayout& layout, const StopToken* stop) {
+  Acceptance acceptance(chains, params, shape, layout);
+  for (const MeetingNode& n : meeting_nodes) {
+    const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
+    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length);
+  }
+  for (const Junction& j : candidates) {
+    ThrowIfStopped(stop, "joining");
+    acceptance.Side(j, max_length);
+  }
+  for (const MeetingNode& n : meeting_nodes) {
+    if (n.ends.size() == 2) acceptance.Meeting(n, max_length);
+  }
+  std::uint32_t completed_sides = 0, completed_links = 0;
+  if (max_completed_length > 0.0) {
+    std::size_t s = 0, m = 0;
+    const auto& sides = completion.sides;
+    const auto& pairs = completion.pairs;
+    while (s < sides.size() || m < pairs.size()) {
+      ThrowIfStopped(stop, "joining");
+      if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
+        completed_sides += acceptance.Side(sides[s++], max_completed_length) ? 1 : 0;
+      } else {
+        const EndMeeting& pair = pairs[m++];
+        completed_links +=
+            acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true}, max_completed_length) ? 1 : 0;
+      }
+    }
+  }
+  Accepted out = std::move(acceptance).Take();
+  out.completed_sides = completed_sides;
+  out.completed_links = completed_links;
+  return out;
+}
+
+// The longest tree joining may build (0 = no limit): max_tube_length, and with the cell's tube
+// length known, max_length_share of it.
+double MaxTreeLength(const JunctionParams& params, double tube_length) {
+  if (!(tube_length > 0.0)) return params.max_tube_length;
+  const double share = params.max_length_share * tube_length;
+  return params.max_tube_length > 0.0 ? std::min(params.max_tube_length, share) : share;
+}
+
 // Sorts longest first and numbers the tubes 0..n−1; rank[t] is the new index of tubes[t].
 std::vector<Tube> LongestFirst(std::vector<Tube> tubes, std::vector<std::uint32_t>* rank) {
   std::vector<double> length(tubes.size());
@@ -608,6 +646,7 @@ void JunctionParams::Validate() const {
   RequireNonNegative(node_spacing, "modeling.junctions.node_spacing");
   RequireNonNegative(max_tube_length, "modeling.junctions.max_tube_length");
   RequirePositive(max_length_share, "modeling.junctions.max_length_share");
+  RequireNonNegative(layout_tolerance, "modeling.junctions.layout_tolerance");
   RequireNonNegative(chain_max_distance, "modeling.junctions.chain_max_distance");
   RequireNonNegative(link_max_distance, "modeling.junctions.link_max_distance");
   RequireInRange(link_max_angle, 0.0, kPi, "modeling.junctions.link_max_angle");
@@ -622,6 +661,24 @@ void JunctionCompletionParams::Validate(const char* prefix) const {
   RequirePositive(max_gap, p + ".max_gap");
   RequirePositive(max_axis_offset, p + ".max_axis_offset");
   RequirePositive(max_length_share, p + ".max_length_share");
+}
+
+bool FitsJunctionLayout(const Tube& tree, const JunctionLayout& layout, double tolerance) {
+  if (!tree.branched() || !layout.known()) return true;
+  const std::vector<std::uint32_t> degree = NodeDegrees(tree);
+  const std::vector<double> length = BranchLengths(tree);
+  std::uint32_t junctions = 0, hidden = 0;
+  for (const std::uint32_t d : degree) junctions += d >= 3 ? 1 : 0;
+  for (std::size_t b = 0; b < tree.branches.size(); ++b) {
+    const bool from = degree[tree.branches[b].from_node] >= 3, to = degree[tree.branches[b].to_node] >= 3;
+    if (from && to) {
+      if (layout.junction_spacing > 0.0 && std::abs(length[b] - layout.junction_spacing) > tolerance)
+        return false;
+    } else if ((from || to) && layout.branch_length > 0.0 && length[b] > layout.branch_length + tolerance) {
+      ++hidden;  // the run goes on through a junction the scan does not show
+    }
+  }
+  return layout.junctions == 0 || junctions + hidden <= layout.junctions;
 }
 
 double ReachOf(const EndRoom& room, double nominal) { return std::min(nominal + room.unfitted, room.free); }
@@ -682,7 +739,8 @@ namespace {
 // JoinJunctions with its trees bounded by `max_tree_length` (0 = no limit).
 JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const JunctionParams& params,
                                     JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                                    double tube_length, double max_tree_length) {
+                                    double tube_length, double max_tree_length,
+                                    const JunctionLayout& layout) {
   params.Validate();
   ThrowIfStopped(stop, "joining");
   CompletionCandidates completion;
@@ -697,7 +755,7 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
   }
   const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
                                    FindJunctions(chains, params, shape, rooms), completion, max_tree_length,
-                                   max_completed_length, params, shape, stop);
+                                   max_completed_length, params, shape, layout, stop);
   JunctionJoining out;
   out.y_pieces =
       static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
@@ -745,27 +803,29 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
 
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
                               JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                              double tube_length) {
+                              double tube_length, const JunctionLayout& layout) {
   return JoinJunctionsWithin(chains, params, shape, stop, rooms, tube_length,
-                             MaxTreeLength(params, tube_length));
+                             MaxTreeLength(params, tube_length), layout);
 }
 
 JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const JunctionParams& params,
                                       JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                                      double tube_length, std::optional<double>* scan_length) {
+                                      double tube_length, std::optional<double>* scan_length,
+                                      const JunctionLayout& layout) {
   if (scan_length != nullptr) scan_length->reset();
-  if (!(tube_length > 0.0)) return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
+  if (!(tube_length > 0.0)) return JoinJunctions(chains, params, shape, stop, rooms, tube_length, layout);
   // The trees within max_tube_length alone: how long are the ones seen about whole? Four of them
   // at least: in a bin of two or three trees one merge can be the median (a 3-tree bin of set C).
   constexpr std::size_t kMinWholeTrees = 4;
   const double whole = WholeTubeLength(
-      JoinJunctionsWithin(chains, params, shape, stop, rooms, tube_length, params.max_tube_length).tubes,
+      JoinJunctionsWithin(chains, params, shape, stop, rooms, tube_length, params.max_tube_length, layout)
+          .tubes,
       tube_length, kMinWholeTrees);
   if (whole <= MaxTreeLength(params, tube_length)) {
-    return JoinJunctions(chains, params, shape, stop, rooms, tube_length);
+    return JoinJunctions(chains, params, shape, stop, rooms, tube_length, layout);
   }
   if (scan_length != nullptr) *scan_length = whole;
-  return JoinJunctions(chains, params, shape, stop, rooms, whole);
+  return JoinJunctions(chains, params, shape, stop, rooms, whole, layout);
 }
 
 bool LooksBranched(const JunctionJoining& joined, const JunctionParams& params) {

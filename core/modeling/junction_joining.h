@@ -99,6 +99,13 @@ struct JunctionParams {
   /// 70.5 → 72.5 %), other seeds and 14 trees a little, set CY with `any` 60.5 → 63.0 %
   /// (docs/ACCURACY.md); 1.07 (the 0.80 m of max_tube_length) is where it was.
   double max_length_share = 1.04;
+  /// With the part's junction layout known (tube.junctions, junction_spacing, branch_length):
+  /// how far a run may differ from the drawing's, metres (FitsJunctionLayout). On generated set-C
+  /// bins the runs between the two junctions of the pure trees measured 0.27–0.34 m against the
+  /// drawing's 0.30, those of trees mixing two parts 0.09–0.42 m; the layout took correct trees
+  /// from 67.0 to 69.0 % (other seeds 58.0 → 61.5 %), and 0.03–0.08 gave the same within a tree
+  /// or two (docs/ACCURACY.md).
+  double layout_tolerance = 0.04;
   /// `auto` topology: a scene counts as branched when at least this many junctions are found ...
   std::uint32_t auto_min_junctions = 3;
   /// ... and at least this many per tube they leave: a bin of linear tubes shows a few chance
@@ -143,6 +150,13 @@ struct Junction {
 std::vector<Junction> FindJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
                                     JunctionShape shape = JunctionShape::kAny, const EndRooms& rooms = {});
 
+/// Whether a tree can be one part of `layout` (JunctionLayout; an unknown field checks nothing):
+/// every branch between two junctions (nodes of three or more branches) is junction_spacing long
+/// within `tolerance`, and the junctions it shows plus one hidden past each branch from a junction
+/// to a free end longer than branch_length + `tolerance` (its run goes on through a junction the
+/// scan does not show) are no more than the part's. A linear tube always fits.
+bool FitsJunctionLayout(const Tube& tree, const JunctionLayout& layout, double tolerance);
+
 /// A free end's reach given its nominal reach (its radius plus max_gap or side_max_gap): longer
 /// by the unfitted surface past it, never past the free space ahead of it.
 double ReachOf(const EndRoom& room, double nominal);
@@ -176,10 +190,12 @@ struct JunctionJoining {
 /// @throws InvalidArgument for invalid parameters. @throws Cancelled when `stop` fires.
 /// `rooms` (MeasureEndRooms of `chains`; empty = none) sets each free end's reach (ReachOf).
 /// `tube_length` (the cell's tube.length, metres; 0 = unknown) bounds every tree
-/// (max_length_share) and the completion (JunctionCompletionParams::max_length_share).
+/// (max_length_share) and the completion (JunctionCompletionParams::max_length_share); every tree
+/// fits `layout` (FitsJunctionLayout within layout_tolerance).
 JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionParams& params,
                               JunctionShape shape = JunctionShape::kAny, const StopToken* stop = nullptr,
-                              const EndRooms& rooms = {}, double tube_length = 0.0);
+                              const EndRooms& rooms = {}, double tube_length = 0.0,
+                              const JunctionLayout& layout = {});
 
 /// JoinJunctions for a cell whose tubes are `tube_length` long (0 = unknown), unless the trees
 /// the scan shows about whole (joined within max_tube_length alone, WholeTubeLength) are longer
@@ -187,7 +203,8 @@ JunctionJoining JoinJunctions(const std::vector<Tube>& chains, const JunctionPar
 /// (optional) receives that length (else nullopt) for the caller to say so.
 JunctionJoining JoinJunctionsOfLength(const std::vector<Tube>& chains, const JunctionParams& params,
                                       JunctionShape shape, const StopToken* stop, const EndRooms& rooms,
-                                      double tube_length, std::optional<double>* scan_length = nullptr);
+                                      double tube_length, std::optional<double>* scan_length = nullptr,
+                                      const JunctionLayout& layout = {});
 
 /// Topology `auto`: whether a scene shows branched tubes (at least auto_min_junctions junctions
 /// and auto_min_per_tube per tube joining left, or at least auto_min_y_pieces Y-pieces).

@@ -91,7 +91,7 @@ JoinedTubes JoinModeledTubes(const ModelingInput& input, const ModelingParams& p
     const EndRooms rooms =
         MeasureEndRooms(UnfittedPoints(filtered, inliers_of), chains, params.junctions.end_room, seen);
     JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop,
-                                                   rooms, input.tube_length, &out.scan_length);
+                                                   rooms, input.tube_length, &out.scan_length, input.layout);
     out.trees = input.topology == TubeTopology::kBranched || LooksBranched(joined, params.junctions);
     spdlog::debug(
         "junctions: {} ({} Y-pieces, {} completions) joining {} of {} chains into {} tubes; topology {}: {}",
@@ -397,6 +397,7 @@ ModelingInput ModelingInputFor(const CellConfig& cell) {
   input.topology = cell.tube.topology;
   input.junction_shape = cell.tube.junction_shape;
   input.tube_length = cell.tube.length;
+  input.layout = cell.tube.layout;
   input.tube_radius = cell.tube.radius;
   return input;
 }

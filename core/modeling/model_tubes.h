@@ -36,6 +36,9 @@ struct ModelingInput {
   /// The length of one tube (CellConfig tube.length), metres; 0 = unknown. Bounds joining
   /// (JoinTubesOfLength, and the junction joining's trees and completion).
   double tube_length = 0.0;
+  /// Where the junctions of the cell's branched parts are (CellConfig tube.junctions,
+  /// junction_spacing, branch_length); unknown fields check nothing (FitsJunctionLayout).
+  JunctionLayout layout;
   /// The radius of the cell's tubes (CellConfig tube.radius), metres; 0 = unknown. Must lie within
   /// the cylinder fit's radii (modeling.cylinders.min_radius, max_radius); the fitted radii are
   /// compared with it (ModelingResult::warnings).

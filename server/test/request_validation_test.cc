@@ -277,6 +277,27 @@ TEST(ValidatePlanPick, JunctionShapeComesFromTheCellOrTheServer) {
   }
 }
 
+TEST(ValidatePlanPick, TheJunctionLayoutComesFromTheCellAndIsRangeChecked) {
+  PlanningDefaults defaults;
+  v1::PlanPickRequest request = ValidRequest();
+  EXPECT_FALSE(ValidatePlanPick(request, defaults).cell.tube.layout.known());  // 0 = unknown
+  request.mutable_cell()->set_tube_junctions(2);
+  request.mutable_cell()->set_tube_junction_spacing(0.30);
+  request.mutable_cell()->set_tube_branch_length(0.15);
+  const JunctionLayout layout = ValidatePlanPick(request, defaults).cell.tube.layout;
+  EXPECT_EQ(layout.junctions, 2u);
+  EXPECT_DOUBLE_EQ(layout.junction_spacing, 0.30);
+  EXPECT_DOUBLE_EQ(layout.branch_length, 0.15);
+  request.mutable_cell()->set_tube_branch_length(-0.15);
+  EXPECT_THAT([&] { (void)ValidatePlanPick(request, defaults); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("cell.tube_branch_length")));
+  // Millimetres sent as metres: a run longer than the whole tube.
+  request.mutable_cell()->set_tube_branch_length(0.15);
+  request.mutable_cell()->set_tube_junction_spacing(300.0);
+  EXPECT_THAT([&] { (void)ValidatePlanPick(request, defaults); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("cell.tube_junction_spacing")));
+}
+
 TEST(ValidatePlanPick, NearlyUnitQuaternionIsNormalised) {
   v1::PlanPickRequest request = ValidRequest();
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));

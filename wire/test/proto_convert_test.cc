@@ -34,6 +34,13 @@ TEST(ProtoConvertTest, CellDescriptionCarriesTheCaptureSensorPose) {
   EXPECT_DOUBLE_EQ(d.tube_radius(), cell.tube.radius);
   EXPECT_DOUBLE_EQ(d.bin_inner_size().x(), cell.bin.inner_size.x());
   EXPECT_DOUBLE_EQ(d.place_pose().position().y(), cell.place.X_BinPlace.translation().y());
+  // The junction layout of branched parts goes along (0 = unknown).
+  EXPECT_EQ(d.tube_junctions(), 0u);
+  cell.tube.layout = JunctionLayout{2, 0.30, 0.15};
+  const v1::CellDescription trees = ToCellDescription(cell, X_BinSensor);
+  EXPECT_EQ(trees.tube_junctions(), 2u);
+  EXPECT_DOUBLE_EQ(trees.tube_junction_spacing(), 0.30);
+  EXPECT_DOUBLE_EQ(trees.tube_branch_length(), 0.15);
 }
 
 }  // namespace

@@ -26,6 +26,9 @@ CellConfig CellOf(const v1::CellDescription& d, const CellConfig& fallback) {
     cell.tube.topology = *topology;
   if (const std::optional<JunctionShape> shape = FromProto(d.tube_junction_shape()))
     cell.tube.junction_shape = *shape;
+  if (d.tube_junctions() > 0) cell.tube.layout.junctions = d.tube_junctions();
+  if (d.tube_junction_spacing() > 0) cell.tube.layout.junction_spacing = d.tube_junction_spacing();
+  if (d.tube_branch_length() > 0) cell.tube.layout.branch_length = d.tube_branch_length();
   return cell;
 }
 

@@ -24,6 +24,7 @@ void WithShapes(const std::string& set, devices::sim::SimCellParams* p) {
     p->cell.tube.length = tree.tube.length;
     p->cell.tube.topology = tree.tube.topology;
     p->cell.tube.junction_shape = tree.tube.junction_shape;
+    p->cell.tube.layout = tree.tube.layout;
   }
   p->tube_shape = shape;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "physics/scene_generator.h"
 
@@ -16,7 +17,31 @@ CellConfig CellForPreset(CellConfig cell, const std::string& preset) {
     cell.tube.topology = TubeTopology::kBranched;
   }
   if (cell.tube.junction_shape == JunctionShape::kAny) cell.tube.junction_shape = PresetJunctionShape(preset);
+  if (!cell.tube.layout.known()) cell.tube.layout = PresetJunctionLayout(preset);
   return cell;
+}
+
+JunctionLayout PresetJunctionLayout(const std::string& preset) {
+  const physics::RandomTubeParams tubes = physics::RandomTubeParams::Preset(preset);
+  std::map<int, int> degree;
+  for (const physics::TubeBranchSpec& b : tubes.branches) {
+    ++degree[b.from_node];
+    ++degree[b.to_node];
+  }
+  JunctionLayout layout;
+  for (const auto& [node, d] : degree) layout.junctions += d >= 3 ? 1 : 0;
+  bool one_spacing = true;
+  for (const physics::TubeBranchSpec& b : tubes.branches) {
+    const bool from = degree[b.from_node] >= 3, to = degree[b.to_node] >= 3;
+    if (from && to) {
+      one_spacing = one_spacing && (layout.junction_spacing == 0.0 || layout.junction_spacing == b.length);
+      layout.junction_spacing = b.length;
+    } else if (from || to) {
+      layout.branch_length = std::max(layout.branch_length, b.length);
+    }
+  }
+  if (!one_spacing) layout.junction_spacing = 0.0;  // runs of several lengths: not one spacing
+  return layout;
 }
 
 JunctionShape PresetJunctionShape(const std::string& preset) {

@@ -77,6 +77,23 @@ TEST(CellConfig, ReadsTheJunctionShapeAndRejectsAnUnknownOneNamingIt) {
   }
 }
 
+TEST(CellConfig, ReadsTheJunctionLayoutAndRejectsARunLongerThanTheTube) {
+  EXPECT_FALSE(ParseCellConfig("{}").tube.layout.known());
+  const CellConfig cell = ParseCellConfig(
+      "tube:\n  length: 0.75\n  junctions: 2\n  junction_spacing: 0.30\n  branch_length: 0.15\n");
+  EXPECT_EQ(cell.tube.layout.junctions, 2u);
+  EXPECT_DOUBLE_EQ(cell.tube.layout.junction_spacing, 0.30);
+  EXPECT_DOUBLE_EQ(cell.tube.layout.branch_length, 0.15);
+  EXPECT_EQ(ParseCellConfig(DumpCellConfig(cell)).tube.layout.junction_spacing, 0.30);
+  EXPECT_THAT([] { ParseCellConfig("tube:\n  length: 0.75\n  junction_spacing: 0.80\n"); },
+              ::testing::ThrowsMessage<InvalidArgument>(
+                  HasSubstr("tube.junction_spacing: 0.8 m is not shorter than the tube (0.75 m)")));
+  EXPECT_THAT([] { ParseCellConfig("tube:\n  branch_length: -0.1\n"); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("tube.branch_length")));
+  EXPECT_THAT([] { ParseCellConfig("tube:\n  junctions: 65\n"); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("tube.junctions: 65 is above 64")));
+}
+
 TEST(CellConfig, RejectsOutOfRangeRadius) {
   try {
     ParseCellConfig("tube:\n  radius: -0.01\n");
@@ -113,7 +130,7 @@ TEST(CellConfig, DumpReadsBackToTheSameCell) {
   cell.sensor.X_BinSensor.linear() =
       Eigen::AngleAxisd(2.5, Eigen::Vector3d(1.0, 0.2, -0.3).normalized()).toRotationMatrix();
   cell.sensor.unit = LengthUnit::kMillimetre;
-  cell.tube = {0.011, 0.0, 0.04};
+  cell.tube = {.radius = 0.011, .length = 0.0, .mass = 0.04, .layout = {3, 0.2, 0.1}};
   cell.place.X_BinPlace.translation() = Eigen::Vector3d(0.1, -0.7, 0.05);
   for (const CellConfig& expected : {CellConfig{}, cell}) {
     const std::string yaml = DumpCellConfig(expected);
@@ -124,6 +141,9 @@ TEST(CellConfig, DumpReadsBackToTheSameCell) {
     EXPECT_EQ(back.tube.radius, expected.tube.radius);
     EXPECT_EQ(back.tube.length, expected.tube.length);
     EXPECT_EQ(back.tube.mass, expected.tube.mass);
+    EXPECT_EQ(back.tube.layout.junctions, expected.tube.layout.junctions);
+    EXPECT_EQ(back.tube.layout.junction_spacing, expected.tube.layout.junction_spacing);
+    EXPECT_EQ(back.tube.layout.branch_length, expected.tube.layout.branch_length);
     EXPECT_TRUE(back.place.X_BinPlace.isApprox(expected.place.X_BinPlace, kTol)) << yaml;
   }
 }

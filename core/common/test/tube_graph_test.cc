@@ -85,6 +85,17 @@ TEST(TubeGraph, ATeeLinksItsBranchToTheJunctionAndCountsTheLinkInItsLength) {
   EXPECT_EQ(pieces[3].cylinder, 2);
 }
 
+TEST(TubeGraph, ABranchIsAsLongAsItsCylindersJointsAndLinks) {
+  const std::vector<double> tee = BranchLengths(TeeTube());
+  ASSERT_EQ(tee.size(), 3u);
+  EXPECT_NEAR(tee[0], 0.10, 1e-12);
+  EXPECT_NEAR(tee[1], 0.10, 1e-12);
+  EXPECT_NEAR(tee[2], 0.03 + 0.10, 1e-12);  // the link from the node, then the cylinder
+  const std::vector<double> linear = BranchLengths(LinearTube());
+  ASSERT_EQ(linear.size(), 1u);
+  EXPECT_NEAR(linear[0], LinearTube().length(), 1e-12);
+}
+
 TEST(TubeGraph, ValidationNamesTheBadField) {
   Tube t = TeeTube();
   t.branches[2].to_node = 7;

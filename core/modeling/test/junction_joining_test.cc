@@ -386,6 +386,70 @@ TEST(JunctionJoining, AutoTopologyNeedsSeveralJunctionsOrYPieces) {
   EXPECT_TRUE(LooksBranched(joined, params));
 }
 
+// A tree of set C's layout: junctions at (0, 0) and (spacing, 0) joined by a straight run, two
+// branches of 0.10 at the first and branches of 0.10 and `long_branch` at the second.
+Tube TwoJunctionTree(double spacing, double long_branch) {
+  Tube t;
+  const Eigen::Vector3d a(0, 0, kR), b(spacing, 0, kR);
+  t.nodes = {TubeNode{a},
+             TubeNode{b},
+             TubeNode{a + 0.10 * Dir(135)},
+             TubeNode{a + 0.10 * Dir(225)},
+             TubeNode{b + 0.10 * Dir(45)},
+             TubeNode{b + long_branch * Dir(-45)}};
+  t.cylinders = {Cyl(a, b, 0), Cyl(a, t.nodes[2].p_Bin, 1), Cyl(a, t.nodes[3].p_Bin, 2),
+                 Cyl(b, t.nodes[4].p_Bin, 3), Cyl(b, t.nodes[5].p_Bin, 4)};
+  t.branches = {TubeBranch{0, 1, 0, 1}, TubeBranch{0, 2, 1, 1}, TubeBranch{0, 3, 2, 1},
+                TubeBranch{1, 4, 3, 1}, TubeBranch{1, 5, 4, 1}};
+  return t;
+}
+
+TEST(JunctionJoining, ATreeFitsTheJunctionLayoutOfItsPart) {
+  const JunctionLayout set_c{2, 0.30, 0.15};
+  EXPECT_TRUE(FitsJunctionLayout(TwoJunctionTree(0.30, 0.15), set_c, 0.04));
+  EXPECT_TRUE(FitsJunctionLayout(TwoJunctionTree(0.33, 0.15), set_c, 0.04));
+  // Two junctions a run of 0.20 apart: one of them is a stranger's.
+  EXPECT_FALSE(FitsJunctionLayout(TwoJunctionTree(0.20, 0.15), set_c, 0.04));
+  EXPECT_TRUE(FitsJunctionLayout(TwoJunctionTree(0.20, 0.15), JunctionLayout{2, 0.0, 0.15}, 0.04));
+  // A branch of 0.25 hides a third junction the part does not have.
+  EXPECT_FALSE(FitsJunctionLayout(TwoJunctionTree(0.30, 0.25), set_c, 0.04));
+  EXPECT_TRUE(FitsJunctionLayout(TwoJunctionTree(0.30, 0.25), JunctionLayout{2, 0.30, 0.0}, 0.04));
+  EXPECT_TRUE(FitsJunctionLayout(TwoJunctionTree(0.30, 0.25), JunctionLayout{3, 0.30, 0.15}, 0.04));
+  // One junction: the trunk may go on through the other, hidden one; two long arms may not.
+  const std::vector<Tube> y = YPiece({0, 0, kR}, 0.0, 0);
+  const JunctionJoining one = JoinJunctions(y, JunctionParams{});
+  ASSERT_EQ(one.tubes.size(), 1u);
+  EXPECT_TRUE(FitsJunctionLayout(one.tubes[0], set_c, 0.04));
+  std::vector<Tube> long_arms = y;
+  long_arms[1].cylinders[0].end = 0.25 * Dir(210) + Eigen::Vector3d(0, 0, kR);
+  const JunctionJoining two_long = JoinJunctions(long_arms, JunctionParams{});
+  ASSERT_EQ(two_long.tubes.size(), 1u);
+  EXPECT_FALSE(FitsJunctionLayout(two_long.tubes[0], set_c, 0.04));
+  EXPECT_TRUE(FitsJunctionLayout(Chain({Cyl({0, 0, kR}, {0.7, 0, kR}, 0)}), set_c, 0.04));
+}
+
+TEST(JunctionJoining, AStrangersEndOnTheTrunkIsNoJunctionWhereThePartHasNone) {
+  // A Y-piece (arms 0.30 up, 0.10, 0.10) and a stranger's end 3 cm from the trunk's side, 0.12 m
+  // up it: a T-piece by its geometry, but set C's two junctions are 0.30 m apart.
+  std::vector<Tube> chains = YPiece({0, 0, kR}, 0.025, 0);
+  chains.push_back(Chain({Cyl({0.13, 0.12, kR}, {0.03, 0.12, kR}, 3)}));
+  const JunctionJoining blind = JoinJunctions(chains, JunctionParams{});
+  ASSERT_EQ(blind.tubes.size(), 1u);
+  EXPECT_EQ(blind.junctions, 2u);
+  const JunctionJoining drawn = JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, {}, 0.0,
+                                              JunctionLayout{2, 0.30, 0.15});
+  ASSERT_EQ(drawn.tubes.size(), 2u);
+  EXPECT_EQ(drawn.junctions, 1u);
+  EXPECT_EQ(drawn.tube_of_chain[0], drawn.tube_of_chain[1]);
+  EXPECT_NE(drawn.tube_of_chain[3], drawn.tube_of_chain[0]);
+  // At 0.30 m up the trunk it would be the part's second junction.
+  chains.back() = Chain({Cyl({0.13, 0.30, kR}, {0.03, 0.30, kR}, 3)});
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, {}, 0.0,
+                          JunctionLayout{2, 0.30, 0.15})
+                .tubes.size(),
+            1u);
+}
+
 TEST(JunctionJoining, IsDeterministicAndKeepsLinearChainsAsTheyCame) {
   std::vector<Tube> chains = YPiece({0, 0, kR}, 0.02, 0);
   const std::vector<Tube> y2 = YPiece({0.4, 0.1, kR}, 0.03, 10);

@@ -34,6 +34,19 @@ WrenchParams Resolution(ResolutionVariant variant) {
   return wrench;
 }
 
+TEST(SimShapes, TreesTellThePlannerTheirLengthTopologyAndJunctionLayout) {
+  SimCellParams p = SimCellParams::Thesis(devices::sim::Material::kPvc, 20, 1);
+  WithShapes("C", &p);
+  EXPECT_EQ(p.cell.tube.topology, TubeTopology::kBranched);
+  EXPECT_NEAR(p.cell.tube.length, 0.75, 1e-9);
+  EXPECT_EQ(p.cell.tube.layout.junctions, 2u);
+  EXPECT_NEAR(p.cell.tube.layout.junction_spacing, 0.30, 1e-9);
+  EXPECT_NEAR(p.cell.tube.layout.branch_length, 0.15, 1e-9);
+  SimCellParams linear = SimCellParams::Thesis(devices::sim::Material::kPvc, 20, 1);
+  WithShapes("B", &linear);
+  EXPECT_FALSE(linear.cell.tube.layout.known());
+}
+
 TEST(ResolutionTrials, ChoosesTheTubeAnotherLiesOnAtItsMiddle) {
   const SimCellParams params;
   SimCell cell(params, BridgedTubes(params.cell.tube.radius));

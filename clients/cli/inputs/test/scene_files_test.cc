@@ -41,7 +41,7 @@ TEST(SceneFiles, TheCellWrittenBesideTheSceneIsTheOneReadBack) {
   cell.bin.inner_size = {0.7, 0.5, 0.25};
   cell.sensor.unit = LengthUnit::kMillimetre;
   cell.sensor.X_BinSensor.translation() = Eigen::Vector3d(0.01, -0.02, 1.3);
-  cell.tube = {.radius = 0.01, .length = 0.4, .mass = 0.07};
+  cell.tube = {.radius = 0.01, .length = 0.4, .mass = 0.07, .layout = {}};
   const fs::path dir = WriteScene("tubepick_scene_files_cell");
   std::ofstream(dir / kSceneCellFile) << DumpCellConfig(cell);  // what `tubepick scene` writes
   const SceneData scene = ReadSceneDirectory(dir.string(), CellConfig{});

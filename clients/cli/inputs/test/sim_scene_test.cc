@@ -22,5 +22,22 @@ TEST(CellForPreset, TreesAreBranchedAndOnlyYPieceTreesExpectAWye) {
   EXPECT_EQ(PresetJunctionShape("B"), JunctionShape::kAny);
 }
 
+TEST(SimScene, ThePresetsJunctionLayoutComesFromItsBranches) {
+  // Set C: a 0.30 m trunk with a junction at each end, branches of 0.10 and 0.15 m.
+  for (const char* preset : {"C", "CY"}) {
+    const JunctionLayout layout = PresetJunctionLayout(preset);
+    EXPECT_EQ(layout.junctions, 2u) << preset;
+    EXPECT_DOUBLE_EQ(layout.junction_spacing, 0.30) << preset;
+    EXPECT_DOUBLE_EQ(layout.branch_length, 0.15) << preset;
+  }
+  EXPECT_FALSE(PresetJunctionLayout("A").known());
+  CellConfig cell;
+  EXPECT_EQ(CellForPreset(cell, "C").tube.layout.junctions, 2u);
+  // A cell that states a layout keeps it.
+  cell.tube.layout.junction_spacing = 0.25;
+  EXPECT_DOUBLE_EQ(CellForPreset(cell, "C").tube.layout.junction_spacing, 0.25);
+  EXPECT_EQ(CellForPreset(cell, "C").tube.layout.junctions, 0u);
+}
+
 }  // namespace
 }  // namespace tubepick::cli
