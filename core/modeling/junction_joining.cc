@@ -449,11 +449,13 @@ class Acceptance {
 
   // A Y-piece (three or more ends) or a link (two).
   bool Meeting(const MeetingNode& meeting, double max_length) {
-    return Fitting([&] { return AcceptMeeting(meeting, max_length); }, meeting.ends.front().first);
+    // With a junction shape, the node may keep three ends of the meeting that leave out its first.
+    return Fitting([&] { return AcceptMeeting(meeting, max_length); },
+                   [&] { return state_.out.meetings.back().ends.front().first; });
   }
 
   bool Side(const Junction& j, double max_length) {
-    return Fitting([&] { return AcceptSide(j, max_length); }, j.branch);
+    return Fitting([&] { return AcceptSide(j, max_length); }, [&] { return j.branch; });
   }
 
   Accepted Take() && { return std::move(state_.out); }
@@ -465,13 +467,14 @@ class Acceptance {
     Accepted out;
   };
 
-  // Accepts with `accept`, then takes it back unless the tree holding `chain` fits the layout.
-  template <typename Accept>
-  bool Fitting(Accept accept, std::uint32_t chain) {
+  // Accepts with `accept`, then takes it back unless the tree now holding `accepted_chain()`
+  // (a chain of what was accepted) fits the layout.
+  template <typename Accept, typename AcceptedChain>
+  bool Fitting(Accept accept, AcceptedChain accepted_chain) {
     if (!layout_.known()) return accept();
     State before = state_;
     if (!accept()) return false;
-    const std::uint32_t root = state_.forest.Find(chain);
+    const std::uint32_t root = state_.forest.Find(accepted_chain());
     std::vector<std::uint32_t> members;
     for (std::uint32_t c = 0; c < chains_.size(); ++c) {
       if (state_.forest.Find(c) == root) members.push_back(c);

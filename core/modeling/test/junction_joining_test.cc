@@ -428,6 +428,22 @@ TEST(JunctionJoining, ATreeFitsTheJunctionLayoutOfItsPart) {
   EXPECT_TRUE(FitsJunctionLayout(Chain({Cyl({0, 0, kR}, {0.7, 0, kR}, 0)}), set_c, 0.04));
 }
 
+TEST(JunctionJoining, AWyeIsCheckedAgainstTheLayoutWhenItLeavesOutTheMeetingsFirstEnd) {
+  // A Y-piece with arms of 0.30, 0.25 and 0.10 (two long arms: three junctions for a part of two)
+  // and, first among the chains, a chance fourth end that meets the node cheapest of all.
+  const Eigen::Vector3d node(0.05, -0.02, kR);
+  std::vector<Tube> arms = YPiece(node, 0.025, 1);
+  arms[1].cylinders[0].end = node + 0.275 * Dir(210);
+  const Eigen::Vector3d d = Dir(90.0 + 35.0);
+  std::vector<Tube> chains = {Chain({Cyl(node + 0.20 * d, node + 0.015 * d, 0)})};
+  chains.insert(chains.end(), arms.begin(), arms.end());
+  ASSERT_EQ(JoinJunctions(chains, JunctionParams{}, JunctionShape::kWye).y_pieces, 1u);
+  const JunctionJoining drawn = JoinJunctions(chains, JunctionParams{}, JunctionShape::kWye, nullptr, {}, 0.0,
+                                              JunctionLayout{2, 0.30, 0.15});
+  EXPECT_EQ(drawn.y_pieces, 0u);
+  EXPECT_EQ(drawn.tubes.size(), 4u);
+}
+
 TEST(JunctionJoining, AStrangersEndOnTheTrunkIsNoJunctionWhereThePartHasNone) {
   // A Y-piece (arms 0.30 up, 0.10, 0.10) and a stranger's end 3 cm from the trunk's side, 0.12 m
   // up it: a T-piece by its geometry, but set C's two junctions are 0.30 m apart.
