@@ -91,23 +91,6 @@ TEST(JunctionJoining, AnEndPointingAtAnotherTubesSideSplitsItIntoATee) {
   EXPECT_NEAR(t.length(), 0.30 + 0.03 + 0.10, 1e-9);
 }
 
-// Every node of a tube is reachable from every other along its branches.
-bool Connected(const Tube& t) {
-  if (t.nodes.empty()) return true;
-  std::vector<bool> seen(t.nodes.size(), false);
-  seen[0] = true;
-  for (bool grew = true; grew;) {
-    grew = false;
-    for (const TubeBranch& b : t.branches) {
-      if (seen[b.from_node] != seen[b.to_node]) {
-        seen[b.from_node] = seen[b.to_node] = true;
-        grew = true;
-      }
-    }
-  }
-  return std::all_of(seen.begin(), seen.end(), [](bool s) { return s; });
-}
-
 TEST(JunctionJoining, TwoTeesWithNoCylinderBetweenThemShareTheirNode) {
   // A run broken by a 5 cm joint (x from -0.02 to 0.03); two branches, from either side, point
   // at the joint 2.5 cm apart (beyond node_spacing): no cylinder lies between their feet, so no
@@ -121,8 +104,7 @@ TEST(JunctionJoining, TwoTeesWithNoCylinderBetweenThemShareTheirNode) {
   ASSERT_EQ(joined.tubes.size(), 1u);
   EXPECT_EQ(joined.junctions, 2u);
   const Tube& t = joined.tubes[0];
-  EXPECT_NO_THROW(ValidateTubeGraph(t, "tube"));
-  EXPECT_TRUE(Connected(t));
+  EXPECT_NO_THROW(ValidateTubeGraph(t, "tube"));  // one tree: every node joined to every other
   const std::vector<std::uint32_t> degree = NodeDegrees(t);
   EXPECT_EQ(std::count(degree.begin(), degree.end(), 4u), 1);  // one node, four arms
   EXPECT_EQ(t.cylinders.size(), 4u);
