@@ -65,6 +65,7 @@ EvaluationAggregate Aggregate(const std::vector<const SceneEvaluation*>& scenes)
     }
     a.mean_total_seconds += s->total_seconds;
     a.max_total_seconds = std::max(a.max_total_seconds, s->total_seconds);
+    a.joins += s->joins;
   }
   const double n = static_cast<double>(scenes.size());
   a.segmentation_error = segmentation_error.Get();

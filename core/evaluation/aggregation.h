@@ -55,6 +55,9 @@ struct EvaluationAggregate {
   std::vector<StageTiming> mean_timings;
   double mean_total_seconds = 0.0;
   double max_total_seconds = 0.0;
+
+  /// Junction joining's decisions against the ground truth, summed.
+  JoinAudit joins;
 };
 
 /// Summarises `scenes` into one row (tube_count = their common count, or 0 when they differ).

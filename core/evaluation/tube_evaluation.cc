@@ -172,6 +172,7 @@ SceneEvaluation EvaluateScene(const ModelingResult& result, const std::vector<st
   out.real_tube_count = n;
   out.filtered_points = static_cast<std::uint32_t>(n_points);
   out.confusion = BuildConfusion(labels.tube, truth, m, n);
+  out.joins = AuditJoins(result, truth);
   const ConfusionMatrix& cm = out.confusion;
 
   // Virtual tubes: majority, purity, stray cylinders.

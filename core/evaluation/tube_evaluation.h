@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/evaluation/assignment.h"
+#include "core/evaluation/join_audit.h"
 #include "core/evaluation/virtual_labelling.h"
 #include "core/evaluation/visible_sections.h"
 #include "core/modeling/model_tubes.h"
@@ -165,6 +166,9 @@ struct SceneEvaluation {
   /// Per-stage timings and total of the modeling run evaluated.
   std::vector<StageTiming> timings;
   double total_seconds = 0.0;
+
+  /// Junction joining's decisions against the ground truth (empty without junction joining).
+  JoinAudit joins;
 
   double micro_recall() const;
   double micro_precision() const;

@@ -254,6 +254,7 @@ struct Accepted {
   // Of them, accepted by the completion (the last T-pieces and links).
   std::uint32_t completed_sides = 0;
   std::uint32_t completed_links = 0;
+  std::vector<JoinDecision> decisions;
 };
 
 // Groups end meetings, cheapest first, into nodes of free ends whose meeting points lie within
@@ -447,18 +448,30 @@ class Acceptance {
         layout_(layout),
         state_{Forest(chains), std::vector<std::array<bool, 2>>(chains.size()), {}} {}
 
-  // A Y-piece (three or more ends) or a link (two).
-  bool Meeting(const MeetingNode& meeting, double max_length) {
+  // A Y-piece (three or more ends) or a link (two), decided as `kind`.
+  bool Meeting(const MeetingNode& meeting, double max_length, JoinDecision::Kind kind) {
     // With a junction shape, the node may keep three ends of the meeting that leave out its first.
-    return Fitting([&] { return AcceptMeeting(meeting, max_length); },
-                   [&] { return state_.out.meetings.back().ends.front().first; });
+    return Fitting(
+        kind, [&] { return AcceptMeeting(meeting, max_length); },
+        [&] {
+          std::vector<std::uint32_t> chains;
+          for (const auto& end : state_.out.meetings.back().ends) chains.push_back(end.first);
+          return chains;
+        });
   }
 
-  bool Side(const Junction& j, double max_length) {
-    return Fitting([&] { return AcceptSide(j, max_length); }, [&] { return j.branch; });
+  bool Side(const Junction& j, double max_length, JoinDecision::Kind kind) {
+    return Fitting(
+        kind, [&] { return AcceptSide(j, max_length); },
+        [&] {
+          return std::vector<std::uint32_t>{j.branch, j.host};
+        });
   }
 
-  Accepted Take() && { return std::move(state_.out); }
+  Accepted Take() && {
+    state_.out.decisions = std::move(decisions_);
+    return std::move(state_.out);
+  }
 
  private:
   struct State {
@@ -467,23 +480,28 @@ class Acceptance {
     Accepted out;
   };
 
-  // Accepts with `accept`, then takes it back unless the tree now holding `accepted_chain()`
-  // (a chain of what was accepted) fits the layout.
-  template <typename Accept, typename AcceptedChain>
-  bool Fitting(Accept accept, AcceptedChain accepted_chain) {
-    if (!layout_.known()) return accept();
+  // Accepts with `accept`, then takes it back unless the tree now holding `joined()` (the chains
+  // it joined) fits the layout; records the decision either way.
+  template <typename Accept, typename Joined>
+  bool Fitting(JoinDecision::Kind kind, Accept accept, Joined joined) {
+    if (!layout_.known()) {
+      if (!accept()) return false;
+      decisions_.push_back({kind, true, joined()});
+      return true;
+    }
     State before = state_;
     if (!accept()) return false;
-    const std::uint32_t root = state_.forest.Find(accepted_chain());
+    JoinDecision decision{kind, true, joined()};
+    const std::uint32_t root = state_.forest.Find(decision.chains.front());
     std::vector<std::uint32_t> members;
     for (std::uint32_t c = 0; c < chains_.size(); ++c) {
       if (state_.forest.Find(c) == root) members.push_back(c);
     }
-    if (FitsJunctionLayout(TreeBuilder(chains_, state_.out).Build(members), layout_,
-                           params_.layout_tolerance))
-      return true;
-    state_ = std::move(before);
-    return false;
+    decision.accepted = FitsJunctionLayout(TreeBuilder(chains_, state_.out).Build(members), layout_,
+                                           params_.layout_tolerance);
+    if (!decision.accepted) state_ = std::move(before);
+    decisions_.push_back(std::move(decision));
+    return decisions_.back().accepted;
   }
 
   bool AcceptMeeting(const MeetingNode& meeting, double max_length) {
@@ -546,6 +564,7 @@ class Acceptance {
   JunctionShape shape_;
   const JunctionLayout& layout_;
   State state_;
+  std::vector<JoinDecision> decisions_;
 };
 
 // What the completion may still accept: T-pieces and pairs of ends within its wider limits.
@@ -564,14 +583,14 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
   Acceptance acceptance(chains, params, shape, layout);
   for (const MeetingNode& n : meeting_nodes) {
     const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
-    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length);
+    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length, JoinDecision::Kind::kYPiece);
   }
   for (const Junction& j : candidates) {
     ThrowIfStopped(stop, "joining");
-    acceptance.Side(j, max_length);
+    acceptance.Side(j, max_length, JoinDecision::Kind::kTPiece);
   }
   for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() == 2) acceptance.Meeting(n, max_length);
+    if (n.ends.size() == 2) acceptance.Meeting(n, max_length, JoinDecision::Kind::kLink);
   }
   std::uint32_t completed_sides = 0, completed_links = 0;
   if (max_completed_length > 0.0) {
@@ -581,11 +600,14 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
     while (s < sides.size() || m < pairs.size()) {
       ThrowIfStopped(stop, "joining");
       if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
-        completed_sides += acceptance.Side(sides[s++], max_completed_length) ? 1 : 0;
+        completed_sides +=
+            acceptance.Side(sides[s++], max_completed_length, JoinDecision::Kind::kCompletionT) ? 1 : 0;
       } else {
         const EndMeeting& pair = pairs[m++];
-        completed_links +=
-            acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true}, max_completed_length) ? 1 : 0;
+        completed_links += acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true},
+                                              max_completed_length, JoinDecision::Kind::kCompletionLink)
+                               ? 1
+                               : 0;
       }
     }
   }
@@ -664,6 +686,22 @@ void JunctionCompletionParams::Validate(const char* prefix) const {
   RequirePositive(max_gap, p + ".max_gap");
   RequirePositive(max_axis_offset, p + ".max_axis_offset");
   RequirePositive(max_length_share, p + ".max_length_share");
+}
+
+std::string ToString(JoinDecision::Kind kind) {
+  switch (kind) {
+    case JoinDecision::Kind::kYPiece:
+      return "y_piece";
+    case JoinDecision::Kind::kTPiece:
+      return "t_piece";
+    case JoinDecision::Kind::kLink:
+      return "link";
+    case JoinDecision::Kind::kCompletionT:
+      return "completion_t";
+    case JoinDecision::Kind::kCompletionLink:
+      return "completion_link";
+  }
+  return "?";
 }
 
 bool FitsJunctionLayout(const Tube& tree, const JunctionLayout& layout, double tolerance) {
@@ -766,6 +804,7 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
   out.junctions =
       static_cast<std::uint32_t>(accepted.junctions.size()) - accepted.completed_sides + out.y_pieces;
   out.completions = accepted.completed_sides + accepted.completed_links;
+  out.decisions = accepted.decisions;
 
   // Components (by the smallest chain index in them), in order of that index.
   std::vector<std::uint32_t> component(chains.size());

@@ -162,6 +162,21 @@ bool FitsJunctionLayout(const Tube& tree, const JunctionLayout& layout, double t
 double ReachOf(const EndRoom& room, double nominal);
 
 /// What junction joining made of a scene's chains.
+/// One decision of junction joining: which input chains a node or link joined, and whether it
+/// stayed. For auditing the joining against ground truth (tubepick eval, AuditJoins): the
+/// candidates a limit turned away before they made a tree are not decisions.
+struct JoinDecision {
+  enum class Kind { kYPiece, kTPiece, kLink, kCompletionT, kCompletionLink };
+  Kind kind = Kind::kYPiece;
+  /// False: taken back because the tree it made does not fit the part's junction layout.
+  bool accepted = true;
+  /// The chains it joins (indices into JoinJunctions' `chains`); a T-piece's branch, then its host.
+  std::vector<std::uint32_t> chains;
+};
+
+/// "y_piece", "t_piece", "link", "completion_t", "completion_link".
+std::string ToString(JoinDecision::Kind kind);
+
 struct JunctionJoining {
   /// Tube ids 0..n−1, longest tube first.
   std::vector<Tube> tubes;
@@ -176,6 +191,8 @@ struct JunctionJoining {
   /// Junctions and links accepted by the completion (JunctionCompletionParams); not counted in
   /// `junctions` nor `y_pieces`, so they never make a scene look branched.
   std::uint32_t completions = 0;
+  /// Every node and link accepted, and every one the layout took back, in the order decided.
+  std::vector<JoinDecision> decisions;
 };
 
 /// Joins linear chains (JoinTubes' output) into trees: nodes where three or more free ends meet

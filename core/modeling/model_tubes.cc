@@ -70,8 +70,11 @@ struct JoinedTubes {
   std::vector<Tube> tubes;
   /// The whole tubes' length when the cell's tube.length is shorter than the scan shows.
   std::optional<double> scan_length;
-  /// Joined as trees (junction joining), not as linear tubes.
+  /// Joined as trees (junction joining), not as linear tubes: then the chains it joined and its
+  /// decisions.
   bool trees = false;
+  std::vector<Tube> chains;
+  std::vector<JoinDecision> decisions;
 };
 
 // The cylinders joined into tubes: linear (JoinTubesOfLength) or, for a branched or `auto` cell,
@@ -99,6 +102,8 @@ JoinedTubes JoinModeledTubes(const ModelingInput& input, const ModelingParams& p
         joined.tubes.size(), ToString(input.topology), out.trees ? "branched" : "linear");
     if (out.trees) {
       out.tubes = std::move(joined.tubes);
+      out.chains = chains;
+      out.decisions = std::move(joined.decisions);
       return out;
     }
   }
@@ -357,6 +362,8 @@ void JoiningStage(const ModelingInput& input, const ModelingParams& params, cons
   JoinedTubes joined = JoinModeledTubes(input, params, fitted.cylinders, cloud.points, fitted.inliers_of,
                                         visibility ? &*visibility : nullptr, stop);
   result.tubes = std::move(joined.tubes);
+  result.chains = std::move(joined.chains);
+  result.join_decisions = std::move(joined.decisions);
   if (joined.scan_length)
     result.warnings.push_back(TubeLengthWarning(input, params, *joined.scan_length, joined.trees));
   result.tube_of_point = TubeOfPoint(result.tubes, fitted.cylinders, fitted.inliers_of, cloud.size());

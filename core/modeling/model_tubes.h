@@ -102,6 +102,10 @@ struct ModelingResult {
   std::vector<std::int32_t> segment_of_point;
   /// Per filtered point: the tube whose cylinder took it as an inlier, or −1.
   std::vector<std::int32_t> tube_of_point;
+  /// When the tubes were joined as trees: the linear chains junction joining started from and its
+  /// decisions (JunctionJoining::decisions, naming those chains); empty otherwise.
+  std::vector<Tube> chains;
+  std::vector<JoinDecision> join_decisions;
 };
 
 /// Runs Algorithm 1: prepare → filters (+ normals) → region growing → cylinders → joining.

@@ -16,6 +16,20 @@ json Timings(const std::vector<StageTiming>& timings) {
   return out;
 }
 
+// Per kind of junction-joining decision: right and wrong ones kept and taken back by the layout;
+// null without junction joining.
+json JoinsJson(const JoinAudit& audit) {
+  if (audit.empty()) return nullptr;
+  json out = {{"chains", audit.chains}, {"mixed_chains", audit.mixed_chains}};
+  for (std::size_t k = 0; k < audit.kinds.size(); ++k) {
+    const JoinAudit::Kind& kind = audit.kinds[k];
+    out[ToString(static_cast<JoinDecision::Kind>(k))] = {
+        {"accepted", {{"right", kind.accepted.right}, {"wrong", kind.accepted.wrong}}},
+        {"refused_by_layout", {{"right", kind.refused.right}, {"wrong", kind.refused.wrong}}}};
+  }
+  return out;
+}
+
 json AggregateJson(const EvaluationAggregate& a) {
   return json{{"tube_count", a.tube_count},
               {"scenes", a.scenes},
@@ -49,7 +63,8 @@ json AggregateJson(const EvaluationAggregate& a) {
               {"accuracy", a.accuracy},
               {"mean_timings", Timings(a.mean_timings)},
               {"mean_total_seconds", a.mean_total_seconds},
-              {"max_total_seconds", a.max_total_seconds}};
+              {"max_total_seconds", a.max_total_seconds},
+              {"joins", JoinsJson(a.joins)}};
 }
 
 json PlanCheckJson(const std::optional<PlanCheck>& c) {
@@ -131,6 +146,7 @@ json SceneJson(const EvaluatedScene& s) {
               {"accuracy", e.accuracy()},
               {"timings", Timings(e.timings)},
               {"total_seconds", e.total_seconds},
+              {"joins", JoinsJson(e.joins)},
               {"real_tubes", real},
               {"virtual_tubes", virt},
               {"confusion", confusion}};

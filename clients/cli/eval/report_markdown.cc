@@ -30,6 +30,28 @@ std::string Failures(const SceneEvaluation& e) {
   return out;
 }
 
+// Junction joining's decisions against the ground truth, over all scenes.
+std::string JoinAuditSection(const JoinAudit& audit) {
+  std::string md = "## Junction joining against the ground truth\n\n";
+  md +=
+      "Every node and link junction joining decided, over all scenes. *Right*: every chain it joins is "
+      "mostly one real tube (the ground truth of the segments its cylinders were fitted to); a wrong one "
+      "kept merges two tubes. *Taken back*: refused because the tree it made does not fit the part's "
+      "junction layout (tube.junctions, junction_spacing, branch_length).\n\n";
+  md += "| decision | kept: right | kept: wrong | taken back: right | taken back: wrong |\n";
+  md += "|---|---:|---:|---:|---:|\n";
+  for (std::size_t k = 0; k < audit.kinds.size(); ++k) {
+    const JoinAudit::Kind& kind = audit.kinds[k];
+    md += fmt::format("| {} | {} | {} | {} | {} |\n", ToString(static_cast<JoinDecision::Kind>(k)),
+                      kind.accepted.right, kind.accepted.wrong, kind.refused.right, kind.refused.wrong);
+  }
+  md += fmt::format(
+      "\nThe linear chains it started from: {}, of which {} join segments of different real tubes (the "
+      "linear joining before the junctions merged them).\n\n",
+      audit.chains, audit.mixed_chains);
+  return md;
+}
+
 std::string PlanCheckSection(const EvalRun& run) {
   std::vector<const PlanCheck*> checks;
   for (const EvaluatedScene& s : run.scenes) checks.push_back(&*s.plan_check);
@@ -122,6 +144,7 @@ std::string FormatMarkdownReport(const EvalRun& run, const std::vector<ReportIma
       "\nMeans per scene, except correct % (correct / all real tubes, pooled) and the micro scores (pooled "
       "points).\n\n";
 
+  if (!all.joins.empty()) md += JoinAuditSection(all.joins);
   if (!run.scenes.empty() && run.scenes.front().plan_check) md += PlanCheckSection(run);
 
   md += "## Modeling time per number of tubes (as thesis Table 4.4)\n\n";

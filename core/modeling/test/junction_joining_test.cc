@@ -448,6 +448,29 @@ TEST(JunctionJoining, AStrangersEndOnTheTrunkIsNoJunctionWhereThePartHasNone) {
             1u);
 }
 
+TEST(JunctionJoining, EveryDecisionNamesItsKindItsChainsAndWhetherTheLayoutKeptIt) {
+  // The Y-piece and the stranger's end on its trunk, as above: the T-piece is decided and kept
+  // without the layout, decided and taken back with it.
+  std::vector<Tube> chains = YPiece({0, 0, kR}, 0.025, 0);
+  chains.push_back(Chain({Cyl({0.13, 0.12, kR}, {0.03, 0.12, kR}, 3)}));
+  const JunctionJoining blind = JoinJunctions(chains, JunctionParams{});
+  ASSERT_EQ(blind.decisions.size(), 2u);
+  EXPECT_EQ(blind.decisions[0].kind, JoinDecision::Kind::kYPiece);
+  EXPECT_TRUE(blind.decisions[0].accepted);
+  EXPECT_EQ(blind.decisions[0].chains, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(blind.decisions[1].kind, JoinDecision::Kind::kTPiece);
+  EXPECT_TRUE(blind.decisions[1].accepted);
+  EXPECT_EQ(blind.decisions[1].chains, (std::vector<std::uint32_t>{3, 0}));  // the branch, then the trunk
+  const JunctionJoining drawn = JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, {}, 0.0,
+                                              JunctionLayout{2, 0.30, 0.15});
+  ASSERT_EQ(drawn.decisions.size(), 2u);
+  EXPECT_TRUE(drawn.decisions[0].accepted);
+  EXPECT_EQ(drawn.decisions[1].kind, JoinDecision::Kind::kTPiece);
+  EXPECT_FALSE(drawn.decisions[1].accepted);
+  EXPECT_EQ(drawn.decisions[1].chains, (std::vector<std::uint32_t>{3, 0}));
+  EXPECT_EQ(ToString(JoinDecision::Kind::kCompletionLink), "completion_link");
+}
+
 TEST(JunctionJoining, IsDeterministicAndKeepsLinearChainsAsTheyCame) {
   std::vector<Tube> chains = YPiece({0, 0, kR}, 0.02, 0);
   const std::vector<Tube> y2 = YPiece({0.4, 0.1, kR}, 0.03, 10);

@@ -58,6 +58,28 @@ TEST(EvalReport, JsonReportCarriesEveryScenesScores) {
   EXPECT_DOUBLE_EQ(j["scenes"][0]["micro_recall"].get<double>(), 0.75);
   EXPECT_EQ(j["images"][0]["scene"], "n2_s7");
   EXPECT_EQ(j["scenes"][0]["confusion"]["counts"], nlohmann::json::parse("[[75, 0, 0]]"));
+  EXPECT_TRUE(j["scenes"][0]["joins"].is_null());  // no junction joining
+}
+
+TEST(EvalReport, TheJunctionJoiningAuditIsInBothReports) {
+  EvalRun run;
+  run.scenes = {Scene("n2_s7", 2, 1, 75)};
+  run.scenes[0].evaluation.real_tubes.resize(2);  // the markdown's confusion matrix reads them
+  JoinAudit& audit = run.scenes[0].evaluation.joins;
+  audit.chains = 9;
+  audit.mixed_chains = 1;
+  audit.kinds[static_cast<std::size_t>(JoinDecision::Kind::kTPiece)].accepted = {.right = 4, .wrong = 1};
+  audit.kinds[static_cast<std::size_t>(JoinDecision::Kind::kLink)].refused = {.right = 2, .wrong = 3};
+  run.overall = Aggregate({&run.scenes[0].evaluation});
+  const nlohmann::json j = nlohmann::json::parse(FormatJsonReport(run, {}));
+  EXPECT_EQ(j["scenes"][0]["joins"]["t_piece"]["accepted"]["wrong"], 1);
+  EXPECT_EQ(j["scenes"][0]["joins"]["link"]["refused_by_layout"]["wrong"], 3);
+  EXPECT_EQ(j["overall"]["joins"]["t_piece"]["accepted"]["right"], 4);
+  EXPECT_EQ(j["overall"]["joins"]["mixed_chains"], 1);
+  const std::string md = FormatMarkdownReport(run, {});
+  EXPECT_THAT(md, HasSubstr("| t_piece | 4 | 1 | 0 | 0 |"));
+  EXPECT_THAT(md, HasSubstr("| link | 0 | 0 | 2 | 3 |"));
+  EXPECT_THAT(md, HasSubstr("The linear chains it started from: 9, of which 1 join"));
 }
 
 TEST(SvgUtil, EscapesMarkupAndColoursBackgroundGrey) {
