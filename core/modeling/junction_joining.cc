@@ -22,14 +22,13 @@
 // 4. Completion: the free ends still unused, as T-pieces and links within the wider limits of
 //    JunctionCompletionParams, cheapest first, where the tree stays within the cell's tube length.
 // Each is accepted only while every tube stays a tree (union-find over chains), each free end is
-// used once, no node exceeds max_branches_per_node and no tube max_tube_length (Acceptance).
+// used once, no node exceeds max_branches_per_node and no tube max_tube_length (Acceptance, with
+// the trees it builds, in junction_acceptance.cc).
 
 #include "core/modeling/junction_joining.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -39,15 +38,21 @@
 #include "core/common/require.h"
 #include "core/common/segment_geometry.h"
 #include "core/common/tube_graph.h"
+#include "core/modeling/junction_acceptance.h"
 #include "core/modeling/tube_joining.h"
 
 namespace tubepick {
 namespace {
 
+using junction_internal::Accept;
+using junction_internal::Accepted;
+using junction_internal::BuildTree;
+using junction_internal::CompletionCandidates;
+using junction_internal::EndMeeting;
+using junction_internal::MeetingNode;
+using junction_internal::ShapeDeviation;
+
 constexpr double kPi = 3.14159265358979323846;
-// A cylinder is split only when both halves are at least this long, metres; otherwise the cut
-// moves to its nearer end.
-constexpr double kMinPiece = 0.002;
 
 // Arc length along a chain's axis pieces at a position (piece index + fraction).
 double ArcAt(const std::vector<AxisPiece>& pieces, double position) {
@@ -72,103 +77,8 @@ Eigen::Vector3d PointAtArc(const std::vector<AxisPiece>& pieces, double arc) {
   return pieces.back().b;
 }
 
-// Where a cut at `position` on a chain's axis pieces falls between two of its cylinders (on a
-// joint, or within kMinPiece of a cylinder's start or end, where TreeBuilder moves the cut): the
-// number of cylinders before it; nullopt inside a cylinder. Two T-nodes at one boundary have no
-// cylinder between them for a branch, so they are one node.
-std::optional<std::size_t> CylinderBoundaryAt(const std::vector<AxisPiece>& pieces, double position) {
-  const auto k = std::min(static_cast<std::size_t>(position), pieces.size() - 1);
-  std::size_t before = 0;
-  for (std::size_t i = 0; i < k; ++i) before += pieces[i].cylinder >= 0 ? 1 : 0;
-  const AxisPiece& piece = pieces[k];
-  if (piece.cylinder < 0) return before;
-  const double length = (piece.b - piece.a).norm();
-  const double t = position - static_cast<double>(k);
-  if (t * length < kMinPiece) return before;
-  if ((1.0 - t) * length < kMinPiece) return before + 1;
-  return std::nullopt;
-}
-
 // Where the arms of a T-junction's run are measured: this far from the node along the run.
 constexpr double kRunArmProbe = 0.03;
-
-// The angles between the three arms of a junction shape, ascending; empty for kAny.
-std::vector<double> ArmAngles(JunctionShape shape) {
-  switch (shape) {
-    case JunctionShape::kAny:
-      return {};
-    case JunctionShape::kWye:
-      return {2.0 * kPi / 3.0, 2.0 * kPi / 3.0, 2.0 * kPi / 3.0};
-    case JunctionShape::kTee:
-      return {kPi / 2.0, kPi / 2.0, kPi};
-  }
-  return {};
-}
-
-// How far a junction's arms (directions away from its node) are from the shape: the largest
-// difference between their angles and the shape's, both ascending; 0 for kAny, infinite for a
-// node with another number of arms.
-double ShapeDeviation(const std::vector<Eigen::Vector3d>& arms, JunctionShape shape) {
-  const std::vector<double> expected = ArmAngles(shape);
-  if (expected.empty()) return 0.0;
-  if (arms.size() != expected.size()) return std::numeric_limits<double>::infinity();
-  std::vector<double> angles;
-  for (std::size_t i = 0; i < arms.size(); ++i) {
-    for (std::size_t k = i + 1; k < arms.size(); ++k) {
-      angles.push_back(std::acos(std::clamp(arms[i].normalized().dot(arms[k].normalized()), -1.0, 1.0)));
-    }
-  }
-  std::sort(angles.begin(), angles.end());
-  double deviation = 0.0;
-  for (std::size_t i = 0; i < angles.size(); ++i)
-    deviation = std::max(deviation, std::abs(angles[i] - expected[i]));
-  return deviation;
-}
-
-class Forest {
- public:
-  explicit Forest(const std::vector<Tube>& chains) : parent_(chains.size()), length_(chains.size()) {
-    std::iota(parent_.begin(), parent_.end(), 0);
-    for (std::size_t i = 0; i < chains.size(); ++i) length_[i] = chains[i].length();
-  }
-  std::uint32_t Find(std::uint32_t i) {
-    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
-    return i;
-  }
-  double Length(std::uint32_t i) { return length_[Find(i)]; }
-  void AddLength(std::uint32_t i, double length) { length_[Find(i)] += length; }
-  void Unite(std::uint32_t a, std::uint32_t b, double link) {
-    a = Find(a);
-    b = Find(b);
-    if (a > b) std::swap(a, b);
-    parent_[b] = a;
-    length_[a] += length_[b] + link;
-  }
-
- private:
-  std::vector<std::uint32_t> parent_;
-  std::vector<double> length_;
-};
-
-// Two free ends whose extended axes meet (a pair of a Y-piece's branches).
-struct EndMeeting {
-  std::pair<std::uint32_t, bool> a;  // (chain, at_end)
-  std::pair<std::uint32_t, bool> b;
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  double cost = 0.0;
-  // Close and straight enough to be linked end to end when no third end meets them.
-  bool linkable = false;
-};
-
-// Free ends meeting at one node: a Y-piece, where every branch ends at the junction.
-struct MeetingNode {
-  std::vector<std::pair<std::uint32_t, bool>> ends;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  int points = 0;
-  bool linkable = false;
-
-  Eigen::Vector3d Centre() const { return sum / points; }
-};
 
 // The reach of a chain's free end (ReachOf), nominal without rooms.
 double RoomReach(const EndRooms& rooms, std::uint32_t chain, bool at_end, double nominal) {
@@ -237,26 +147,6 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
   return out;
 }
 
-// A node on a host chain: the junctions that share it.
-struct HostNode {
-  double arc = 0.0;
-  double position = 0.0;  // on the host's axis pieces
-  Eigen::Vector3d p_Bin = Eigen::Vector3d::Zero();
-  std::uint32_t degree = 2;  // the two halves of the host
-};
-
-struct Accepted {
-  std::vector<Junction> junctions;
-  // Per accepted junction: its host node (index into nodes_of_host[host]).
-  std::vector<std::size_t> node_of_junction;
-  std::map<std::uint32_t, std::vector<HostNode>> nodes_of_host;
-  std::vector<MeetingNode> meetings;
-  // Of them, accepted by the completion (the last T-pieces and links).
-  std::uint32_t completed_sides = 0;
-  std::uint32_t completed_links = 0;
-  std::vector<JoinDecision> decisions;
-};
-
 // Groups end meetings, cheapest first, into nodes of free ends whose meeting points lie within
 // node_spacing of the node's centre (one end per chain, at most max_branches_per_node); only
 // nodes of three or more ends are junctions.
@@ -294,327 +184,6 @@ std::vector<MeetingNode> ClusterMeetings(const std::vector<EndMeeting>& meetings
     }
   }
   return junctions;
-}
-
-// A Y-piece's node with a junction shape: the three of its ends whose arms fit the shape best,
-// or nullopt when none fit within shape_tolerance (a chance end among them, or no Y at all).
-std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<Tube>& chains,
-                                       JunctionShape shape, double tolerance) {
-  if (shape == JunctionShape::kAny) return n;
-  std::optional<MeetingNode> best;
-  double best_deviation = tolerance;
-  const std::size_t k = n.ends.size();
-  for (std::size_t a = 0; a < k; ++a) {
-    for (std::size_t b = a + 1; b < k; ++b) {
-      for (std::size_t c = b + 1; c < k; ++c) {
-        const std::vector<std::pair<std::uint32_t, bool>> ends = {n.ends[a], n.ends[b], n.ends[c]};
-        std::vector<Eigen::Vector3d> arms;
-        for (const auto& [chain, at_end] : ends) arms.push_back(-FreeEndOf(chains[chain], at_end).out);
-        const double deviation = ShapeDeviation(arms, shape);
-        if (deviation > best_deviation) continue;
-        best_deviation = deviation;
-        best = n;
-        best->ends = ends;
-      }
-    }
-  }
-  return best;
-}
-
-// Builds one tree from the chains of a component and the junctions among them.
-class TreeBuilder {
- public:
-  TreeBuilder(const std::vector<Tube>& chains, const Accepted& accepted)
-      : chains_(chains), accepted_(accepted) {}
-
-  Tube Build(const std::vector<std::uint32_t>& members) {
-    tube_ = Tube{};
-    node_id_.clear();
-    // Nodes of the junctions first (Y-pieces, then in host order), so that branch ends can name
-    // them.
-    for (std::size_t k = 0; k < accepted_.meetings.size(); ++k) {
-      const MeetingNode& n = accepted_.meetings[k];
-      if (std::find(members.begin(), members.end(), n.ends.front().first) == members.end()) continue;
-      node_id_[{kMeeting, k}] = static_cast<std::uint32_t>(tube_.nodes.size());
-      tube_.nodes.push_back(TubeNode{n.Centre()});
-    }
-    for (const std::uint32_t c : members) {
-      const auto it = accepted_.nodes_of_host.find(c);
-      if (it == accepted_.nodes_of_host.end()) continue;
-      for (std::size_t k = 0; k < it->second.size(); ++k) {
-        node_id_[{c, k}] = static_cast<std::uint32_t>(tube_.nodes.size());
-        tube_.nodes.push_back(TubeNode{it->second[k].p_Bin});
-      }
-    }
-    for (const std::uint32_t c : members) AddChain(c);
-    return WithoutPassThroughNodes(tube_);
-  }
-
- private:
-  // The node a chain's free end is linked to, or a new end node.
-  std::uint32_t EndNode(std::uint32_t chain, bool at_end) {
-    for (std::size_t k = 0; k < accepted_.meetings.size(); ++k) {
-      const auto& ends = accepted_.meetings[k].ends;
-      if (std::find(ends.begin(), ends.end(), std::make_pair(chain, at_end)) != ends.end()) {
-        return node_id_.at({kMeeting, k});
-      }
-    }
-    for (std::size_t i = 0; i < accepted_.junctions.size(); ++i) {
-      const Junction& j = accepted_.junctions[i];
-      if (j.branch == chain && j.at_end == at_end)
-        return node_id_.at({j.host, accepted_.node_of_junction[i]});
-    }
-    tube_.nodes.push_back(TubeNode{FreeEndOf(chains_[chain], at_end).p});
-    return static_cast<std::uint32_t>(tube_.nodes.size() - 1);
-  }
-
-  void CloseBranch(std::uint32_t to_node) {
-    const auto count = static_cast<std::uint32_t>(tube_.cylinders.size()) - first_;
-    if (count > 0) tube_.branches.push_back(TubeBranch{from_, to_node, first_, count});
-    from_ = to_node;
-    first_ = static_cast<std::uint32_t>(tube_.cylinders.size());
-  }
-
-  void AddChain(std::uint32_t c) {
-    const Tube& chain = chains_[c];
-    const std::vector<AxisPiece> pieces = TubeAxisPieces(chain);
-    // Cuts: (position on the pieces, node id), ascending.
-    std::vector<std::pair<double, std::uint32_t>> cuts;
-    if (const auto it = accepted_.nodes_of_host.find(c); it != accepted_.nodes_of_host.end()) {
-      for (std::size_t k = 0; k < it->second.size(); ++k)
-        cuts.emplace_back(it->second[k].position, node_id_.at({c, k}));
-    }
-    std::sort(cuts.begin(), cuts.end());
-    from_ = EndNode(c, /*at_end=*/false);
-    first_ = static_cast<std::uint32_t>(tube_.cylinders.size());
-    std::size_t next_cut = 0;
-    for (std::size_t k = 0; k < pieces.size(); ++k) {
-      const AxisPiece& piece = pieces[k];
-      if (piece.cylinder < 0) {  // a joint: cuts on it fall between its two cylinders
-        while (next_cut < cuts.size() && cuts[next_cut].first < static_cast<double>(k + 1)) {
-          CloseBranch(cuts[next_cut++].second);
-        }
-        continue;
-      }
-      Cylinder cylinder = chain.cylinders[static_cast<std::size_t>(piece.cylinder)];
-      const double length = cylinder.length();
-      double done = 0.0;  // fraction of this cylinder already emitted
-      while (next_cut < cuts.size() && cuts[next_cut].first < static_cast<double>(k + 1)) {
-        const double t = cuts[next_cut].first - static_cast<double>(k);
-        const std::uint32_t node = cuts[next_cut++].second;
-        if ((t - done) * length < kMinPiece) {  // at the start of what is left: cut before it
-          CloseBranch(node);
-        } else if ((1.0 - t) * length < kMinPiece) {  // at its end: cut after it
-          tube_.cylinders.push_back(cylinder);
-          done = 1.0;
-          CloseBranch(node);
-        } else {
-          const Eigen::Vector3d foot = chain.cylinders[static_cast<std::size_t>(piece.cylinder)].start +
-                                       t * (chain.cylinders[static_cast<std::size_t>(piece.cylinder)].end -
-                                            chain.cylinders[static_cast<std::size_t>(piece.cylinder)].start);
-          Cylinder first = cylinder;
-          first.end = foot;
-          tube_.cylinders.push_back(first);
-          cylinder.start = foot;
-          done = t;
-          CloseBranch(node);
-        }
-      }
-      if (done < 1.0) tube_.cylinders.push_back(cylinder);
-    }
-    CloseBranch(EndNode(c, /*at_end=*/true));
-  }
-
-  // The "host" of a Y-piece's node in node_id_'s keys.
-  static constexpr std::uint32_t kMeeting = ~std::uint32_t{0};
-  const std::vector<Tube>& chains_;
-  const Accepted& accepted_;
-  Tube tube_;
-  std::map<std::pair<std::uint32_t, std::size_t>, std::uint32_t> node_id_;
-  std::uint32_t from_ = 0;
-  std::uint32_t first_ = 0;
-};
-
-// Accepts nodes one by one while every tube stays a tree (union-find over chains), each free
-// end is used once, no node exceeds its branches, no tube the given length and, with the part's
-// junction layout known, every tree fits it (FitsJunctionLayout).
-class Acceptance {
- public:
-  Acceptance(const std::vector<Tube>& chains, const JunctionParams& params, JunctionShape shape,
-             const JunctionLayout& layout)
-      : chains_(chains),
-        params_(params),
-        shape_(shape),
-        layout_(layout),
-        state_{Forest(chains), std::vector<std::array<bool, 2>>(chains.size()), {}} {}
-
-  // A Y-piece (three or more ends) or a link (two), decided as `kind`.
-  bool Meeting(const MeetingNode& meeting, double max_length, JoinDecision::Kind kind) {
-    // With a junction shape, the node may keep three ends of the meeting that leave out its first.
-    return Fitting(
-        kind, [&] { return AcceptMeeting(meeting, max_length); },
-        [&] {
-          std::vector<std::uint32_t> chains;
-          for (const auto& end : state_.out.meetings.back().ends) chains.push_back(end.first);
-          return chains;
-        });
-  }
-
-  bool Side(const Junction& j, double max_length, JoinDecision::Kind kind) {
-    return Fitting(
-        kind, [&] { return AcceptSide(j, max_length); },
-        [&] {
-          return std::vector<std::uint32_t>{j.branch, j.host};
-        });
-  }
-
-  Accepted Take() && {
-    state_.out.decisions = std::move(decisions_);
-    return std::move(state_.out);
-  }
-
- private:
-  struct State {
-    Forest forest;
-    std::vector<std::array<bool, 2>> end_used;
-    Accepted out;
-  };
-
-  // Accepts with `accept`, then takes it back unless the tree now holding `joined()` (the chains
-  // it joined) fits the layout; records the decision either way.
-  template <typename Accept, typename Joined>
-  bool Fitting(JoinDecision::Kind kind, Accept accept, Joined joined) {
-    if (!layout_.known()) {
-      if (!accept()) return false;
-      decisions_.push_back({kind, true, joined()});
-      return true;
-    }
-    State before = state_;
-    if (!accept()) return false;
-    JoinDecision decision{kind, true, joined()};
-    const std::uint32_t root = state_.forest.Find(decision.chains.front());
-    std::vector<std::uint32_t> members;
-    for (std::uint32_t c = 0; c < chains_.size(); ++c) {
-      if (state_.forest.Find(c) == root) members.push_back(c);
-    }
-    decision.accepted = FitsJunctionLayout(TreeBuilder(chains_, state_.out).Build(members), layout_,
-                                           params_.layout_tolerance);
-    if (!decision.accepted) state_ = std::move(before);
-    decisions_.push_back(std::move(decision));
-    return decisions_.back().accepted;
-  }
-
-  bool AcceptMeeting(const MeetingNode& meeting, double max_length) {
-    const std::optional<MeetingNode> fitting =
-        meeting.ends.size() >= 3 ? FittingEnds(meeting, chains_, shape_, params_.shape_tolerance) : meeting;
-    if (!fitting) return false;
-    const MeetingNode& n = *fitting;
-    std::vector<std::uint32_t> roots;
-    double links = 0.0;
-    for (const auto& [chain, at_end] : n.ends) {
-      if (Used(chain, at_end)) return false;
-      roots.push_back(state_.forest.Find(chain));
-      links += (FreeEndOf(chains_[chain], at_end).p - n.Centre()).norm();
-    }
-    std::sort(roots.begin(), roots.end());
-    if (std::adjacent_find(roots.begin(), roots.end()) != roots.end()) return false;  // a cycle
-    double length = links;
-    for (const std::uint32_t r : roots) length += state_.forest.Length(r);
-    if (max_length > 0.0 && length > max_length) return false;
-    for (std::size_t k = 1; k < n.ends.size(); ++k)
-      state_.forest.Unite(n.ends[0].first, n.ends[k].first, 0.0);
-    state_.forest.AddLength(n.ends[0].first, links);
-    for (const auto& [chain, at_end] : n.ends) Use(chain, at_end);
-    state_.out.meetings.push_back(n);
-    return true;
-  }
-
-  // A T-piece: the branch's free end on the host's side.
-  bool AcceptSide(const Junction& j, double max_length) {
-    if (Used(j.branch, j.at_end) || state_.forest.Find(j.branch) == state_.forest.Find(j.host)) return false;
-    const double link = (j.p_Bin - FreeEndOf(chains_[j.branch], j.at_end).p).norm();
-    if (max_length > 0.0 && state_.forest.Length(j.branch) + state_.forest.Length(j.host) + link > max_length)
-      return false;
-    std::vector<HostNode>& nodes = state_.out.nodes_of_host[j.host];
-    const std::vector<AxisPiece> pieces = TubeAxisPieces(chains_[j.host]);
-    const std::optional<std::size_t> boundary = CylinderBoundaryAt(pieces, j.host_position);
-    auto near = std::find_if(nodes.begin(), nodes.end(), [&](const HostNode& n) {
-      return std::abs(n.arc - j.host_arc) < params_.node_spacing ||
-             (boundary && CylinderBoundaryAt(pieces, n.position) == boundary);
-    });
-    const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
-    if (near != nodes.end() && near->degree + 1 > max_branches) return false;
-    if (near == nodes.end()) {
-      nodes.push_back(HostNode{j.host_arc, j.host_position, j.p_Bin, 2});
-      near = nodes.end() - 1;
-    }
-    ++near->degree;
-    Use(j.branch, j.at_end);
-    state_.forest.Unite(j.branch, j.host, link);
-    state_.out.junctions.push_back(j);
-    state_.out.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
-    return true;
-  }
-
-  bool Used(std::uint32_t chain, bool at_end) const { return state_.end_used[chain][at_end ? 1 : 0]; }
-  void Use(std::uint32_t chain, bool at_end) { state_.end_used[chain][at_end ? 1 : 0] = true; }
-
-  const std::vector<Tube>& chains_;
-  const JunctionParams& params_;
-  JunctionShape shape_;
-  const JunctionLayout& layout_;
-  State state_;
-  std::vector<JoinDecision> decisions_;
-};
-
-// What the completion may still accept: T-pieces and pairs of ends within its wider limits.
-struct CompletionCandidates {
-  std::vector<Junction> sides;
-  std::vector<EndMeeting> pairs;
-};
-
-// Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
-// first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
-// completion's candidates, cheapest first across both kinds.
-Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
-                const std::vector<Junction>& candidates, const CompletionCandidates& completion,
-                double max_length, double max_completed_length, const JunctionParams& params,
-                JunctionShape shape, const JunctionLayout& layout, const StopToken* stop) {
-  Acceptance acceptance(chains, params, shape, layout);
-  for (const MeetingNode& n : meeting_nodes) {
-    const bool ambiguous = shape == JunctionShape::kAny && n.ends.size() > params.max_meeting_ends;
-    if (n.ends.size() >= 3 && !ambiguous) acceptance.Meeting(n, max_length, JoinDecision::Kind::kYPiece);
-  }
-  for (const Junction& j : candidates) {
-    ThrowIfStopped(stop, "joining");
-    acceptance.Side(j, max_length, JoinDecision::Kind::kTPiece);
-  }
-  for (const MeetingNode& n : meeting_nodes) {
-    if (n.ends.size() == 2) acceptance.Meeting(n, max_length, JoinDecision::Kind::kLink);
-  }
-  std::uint32_t completed_sides = 0, completed_links = 0;
-  if (max_completed_length > 0.0) {
-    std::size_t s = 0, m = 0;
-    const auto& sides = completion.sides;
-    const auto& pairs = completion.pairs;
-    while (s < sides.size() || m < pairs.size()) {
-      ThrowIfStopped(stop, "joining");
-      if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
-        completed_sides +=
-            acceptance.Side(sides[s++], max_completed_length, JoinDecision::Kind::kCompletionT) ? 1 : 0;
-      } else {
-        const EndMeeting& pair = pairs[m++];
-        completed_links += acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true},
-                                              max_completed_length, JoinDecision::Kind::kCompletionLink)
-                               ? 1
-                               : 0;
-      }
-    }
-  }
-  Accepted out = std::move(acceptance).Take();
-  out.completed_sides = completed_sides;
-  out.completed_links = completed_links;
-  return out;
 }
 
 // The longest tree joining may build (0 = no limit): max_tube_length, and with the cell's tube
@@ -828,11 +397,10 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
   for (std::uint32_t c = 0; c < chains.size(); ++c) members[component[c]].push_back(c);
   std::vector<Tube> tubes;
   std::vector<std::uint32_t> built_from(chains.size());
-  TreeBuilder builder(chains, accepted);
   for (const auto& [root, list] : members) {
     for (const std::uint32_t c : list) built_from[c] = static_cast<std::uint32_t>(tubes.size());
     if (list.size() > 1) out.chains_in_junctions += static_cast<std::uint32_t>(list.size());
-    tubes.push_back(list.size() == 1 ? chains[list.front()] : builder.Build(list));
+    tubes.push_back(list.size() == 1 ? chains[list.front()] : BuildTree(chains, accepted, list));
   }
   std::vector<std::uint32_t> rank;
   out.tubes = LongestFirst(std::move(tubes), &rank);
