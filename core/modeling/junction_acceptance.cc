@@ -247,6 +247,20 @@ class Acceptance {
         });
   }
 
+  // A completion pair one of whose ends is already at a node: the other end joins that node as one
+  // more branch.
+  bool AtNode(const EndMeeting& pair, double max_length) {
+    if (Used(pair.a.first, pair.a.second) == Used(pair.b.first, pair.b.second)) return false;
+    const bool a_at_node = Used(pair.a.first, pair.a.second);
+    const auto& at_node = a_at_node ? pair.a : pair.b;
+    const auto& free = a_at_node ? pair.b : pair.a;
+    return Fitting(
+        JoinDecision::Kind::kCompletionNode, [&] { return AcceptAtNode(at_node, free, max_length); },
+        [&] {
+          return std::vector<std::uint32_t>{free.first, at_node.first};
+        });
+  }
+
   Accepted Take() && {
     state_.out.decisions = std::move(decisions_);
     return std::move(state_.out);
@@ -335,6 +349,50 @@ class Acceptance {
     return true;
   }
 
+  // `free` joins the node `at_node` is at: a Y-piece or link (one more end of the meeting) or a
+  // T-node (one more branch at the host's node).
+  bool AcceptAtNode(const std::pair<std::uint32_t, bool>& at_node, const std::pair<std::uint32_t, bool>& free,
+                    double max_length) {
+    const std::uint32_t max_branches = shape_ == JunctionShape::kAny ? params_.max_branches_per_node : 3;
+    const Eigen::Vector3d p_free = FreeEndOf(chains_[free.first], free.second).p;
+    if (state_.forest.Find(free.first) == state_.forest.Find(at_node.first)) return false;
+    auto within = [&](const Eigen::Vector3d& p_node) {
+      const double link = (p_node - p_free).norm();
+      return max_length <= 0.0 ||
+             state_.forest.Length(free.first) + state_.forest.Length(at_node.first) + link <= max_length;
+    };
+    for (MeetingNode& n : state_.out.meetings) {
+      if (std::find(n.ends.begin(), n.ends.end(), at_node) == n.ends.end()) continue;
+      if (n.ends.size() + 1 > max_branches || !within(n.Centre())) return false;
+      if (shape_ != JunctionShape::kAny && n.ends.size() + 1 == 3) {
+        std::vector<Eigen::Vector3d> arms;
+        for (const auto& [chain, at_end] : n.ends) arms.push_back(-FreeEndOf(chains_[chain], at_end).out);
+        arms.push_back(-FreeEndOf(chains_[free.first], free.second).out);
+        if (ShapeDeviation(arms, shape_) > params_.shape_tolerance) return false;
+      }
+      state_.forest.Unite(n.ends.front().first, free.first, (n.Centre() - p_free).norm());
+      n.ends.push_back(free);
+      Use(free.first, free.second);
+      return true;
+    }
+    for (std::size_t i = 0; i < state_.out.junctions.size(); ++i) {
+      const Junction& j = state_.out.junctions[i];
+      if (j.branch != at_node.first || j.at_end != at_node.second) continue;
+      HostNode& node = state_.out.nodes_of_host[j.host][state_.out.node_of_junction[i]];
+      if (node.degree + 1 > max_branches || !within(node.p_Bin)) return false;
+      Junction added = j;
+      added.branch = free.first;
+      added.at_end = free.second;
+      ++node.degree;
+      Use(free.first, free.second);
+      state_.forest.Unite(free.first, j.host, (node.p_Bin - p_free).norm());
+      state_.out.junctions.push_back(added);
+      state_.out.node_of_junction.push_back(state_.out.node_of_junction[i]);
+      return true;
+    }
+    return false;
+  }
+
   bool Used(std::uint32_t chain, bool at_end) const { return state_.end_used[chain][at_end ? 1 : 0]; }
   void Use(std::uint32_t chain, bool at_end) { state_.end_used[chain][at_end ? 1 : 0] = true; }
 
@@ -372,7 +430,8 @@ Tube BuildTree(const std::vector<Tube>& chains, const Accepted& accepted,
 
 // Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
 // first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
-// completion's candidates, cheapest first across both kinds.
+// completion's candidates, cheapest first across both kinds: a pair of ends one of which is already
+// at a node joins the other to that node.
 Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
                 const std::vector<Junction>& candidates, const CompletionCandidates& completion,
                 double max_length, double max_completed_length, const JunctionParams& params,
@@ -389,7 +448,6 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
   for (const MeetingNode& n : meeting_nodes) {
     if (n.ends.size() == 2) acceptance.Meeting(n, max_length, JoinDecision::Kind::kLink);
   }
-  std::uint32_t completed_sides = 0, completed_links = 0;
   if (max_completed_length > 0.0) {
     std::size_t s = 0, m = 0;
     const auto& sides = completion.sides;
@@ -397,20 +455,15 @@ Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>&
     while (s < sides.size() || m < pairs.size()) {
       ThrowIfStopped(stop, "joining");
       if (m >= pairs.size() || (s < sides.size() && sides[s].reach + sides[s].offset <= pairs[m].cost)) {
-        completed_sides +=
-            acceptance.Side(sides[s++], max_completed_length, JoinDecision::Kind::kCompletionT) ? 1 : 0;
+        acceptance.Side(sides[s++], max_completed_length, JoinDecision::Kind::kCompletionT);
       } else {
         const EndMeeting& pair = pairs[m++];
-        completed_links += acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true},
-                                              max_completed_length, JoinDecision::Kind::kCompletionLink)
-                               ? 1
-                               : 0;
+        if (!acceptance.Meeting(MeetingNode{{pair.a, pair.b}, pair.p, 1, true}, max_completed_length,
+                                JoinDecision::Kind::kCompletionLink))
+          acceptance.AtNode(pair, max_completed_length);
       }
     }
   }
-  Accepted out = std::move(acceptance).Take();
-  out.completed_sides = completed_sides;
-  out.completed_links = completed_links;
-  return out;
+  return std::move(acceptance).Take();
 }
 }  // namespace tubepick::junction_internal

@@ -51,9 +51,7 @@ struct Accepted {
   std::vector<std::size_t> node_of_junction;
   std::map<std::uint32_t, std::vector<HostNode>> nodes_of_host;
   std::vector<MeetingNode> meetings;
-  // Of them, accepted by the completion (the last T-pieces and links).
-  std::uint32_t completed_sides = 0;
-  std::uint32_t completed_links = 0;
+  // Every decision, in order (JunctionJoining::decisions): what counts as a junction or a completion.
   std::vector<JoinDecision> decisions;
 };
 
@@ -75,7 +73,8 @@ Tube BuildTree(const std::vector<Tube>& chains, const Accepted& accepted,
 
 // Y-pieces first (their ends are spoken for), then T-pieces, then end-to-end links, each cheapest
 // first and within `max_length` (0 = no limit); then, within `max_completed_length` (0 = none), the
-// completion's candidates, cheapest first across both kinds.
+// completion's candidates, cheapest first across both kinds: a pair of ends one of which is already
+// at a node joins the other to that node.
 Accepted Accept(const std::vector<Tube>& chains, const std::vector<MeetingNode>& meeting_nodes,
                 const std::vector<Junction>& candidates, const CompletionCandidates& completion,
                 double max_length, double max_completed_length, const JunctionParams& params,

@@ -269,6 +269,8 @@ std::string ToString(JoinDecision::Kind kind) {
       return "completion_t";
     case JoinDecision::Kind::kCompletionLink:
       return "completion_link";
+    case JoinDecision::Kind::kCompletionNode:
+      return "completion_node";
   }
   return "?";
 }
@@ -367,12 +369,25 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
                                    FindJunctions(chains, params, shape, rooms), completion, max_tree_length,
                                    max_completed_length, params, shape, layout, stop);
   JunctionJoining out;
-  out.y_pieces =
-      static_cast<std::uint32_t>(std::count_if(accepted.meetings.begin(), accepted.meetings.end(),
-                                               [](const MeetingNode& n) { return n.ends.size() >= 3; }));
-  out.junctions =
-      static_cast<std::uint32_t>(accepted.junctions.size()) - accepted.completed_sides + out.y_pieces;
-  out.completions = accepted.completed_sides + accepted.completed_links;
+  for (const JoinDecision& d : accepted.decisions) {
+    if (!d.accepted) continue;
+    switch (d.kind) {
+      case JoinDecision::Kind::kYPiece:
+        ++out.y_pieces;
+        ++out.junctions;
+        break;
+      case JoinDecision::Kind::kTPiece:
+        ++out.junctions;
+        break;
+      case JoinDecision::Kind::kLink:
+        break;
+      case JoinDecision::Kind::kCompletionT:
+      case JoinDecision::Kind::kCompletionLink:
+      case JoinDecision::Kind::kCompletionNode:
+        ++out.completions;
+        break;
+    }
+  }
   out.decisions = accepted.decisions;
 
   // Components (by the smallest chain index in them), in order of that index.

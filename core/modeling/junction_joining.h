@@ -18,7 +18,11 @@ namespace tubepick {
 /// saddle unfitted, the fitting under another tube) or whose extended axis misses the other's by
 /// up to 2 cm (a bent branch fitted straight) then still joins its tree, while a tree that is
 /// already whole cannot take a stranger's fragment. On generated set-C bins, 60.5 → 65.0 %
-/// correct (docs/ACCURACY.md).
+/// correct (docs/ACCURACY.md). A pair of ends of which one is already at a node (a Y-piece, a link
+/// or a T-node) joins the other end to that node as one more branch, within
+/// max_branches_per_node: the third branch of a Y whose two others were linked, a branch whose
+/// end the Y-piece's reach just missed. On generated set-C bins 69.0 → 74.0 % correct (one pure
+/// ≥ 80 %: 151 → 160 of 200; docs/ACCURACY.md).
 struct JunctionCompletionParams {
   bool enabled = true;
   /// As JunctionParams::max_gap and side_max_gap, for completion, metres.
@@ -166,7 +170,9 @@ double ReachOf(const EndRoom& room, double nominal);
 /// stayed. For auditing the joining against ground truth (tubepick eval, AuditJoins): the
 /// candidates a limit turned away before they made a tree are not decisions.
 struct JoinDecision {
-  enum class Kind { kYPiece, kTPiece, kLink, kCompletionT, kCompletionLink };
+  /// kCompletionNode: a free end joined to the node where a completion pair's other end already
+  /// is (a Y-piece's or link's meeting, or a T-node), as one more branch.
+  enum class Kind { kYPiece, kTPiece, kLink, kCompletionT, kCompletionLink, kCompletionNode };
   Kind kind = Kind::kYPiece;
   /// False: taken back because the tree it made does not fit the part's junction layout.
   bool accepted = true;
@@ -174,7 +180,7 @@ struct JoinDecision {
   std::vector<std::uint32_t> chains;
 };
 
-/// "y_piece", "t_piece", "link", "completion_t", "completion_link".
+/// "y_piece", "t_piece", "link", "completion_t", "completion_link", "completion_node".
 std::string ToString(JoinDecision::Kind kind);
 
 struct JunctionJoining {

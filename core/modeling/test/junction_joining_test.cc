@@ -281,6 +281,62 @@ TEST(JunctionJoining, TwoArmsOfAYWhoseThirdIsHiddenAreLinkedAcrossAWideKink) {
   EXPECT_EQ(JoinJunctions(chains, params).tubes.size(), 2u);
 }
 
+TEST(JunctionJoining, TheThirdArmOfALinkedPairJoinsTheirNodeInTheCompletion) {
+  // Two arms linked across a 130° kink at `node` (as above) and a third arm whose end lies 9 cm
+  // from the node, pointing at it: past a Y-piece's reach (radius + 5 cm), within the
+  // completion's (radius + 8 cm). The completion pairs it with an end the link already took.
+  const Eigen::Vector3d node(0, 0, kR);
+  const std::vector<Tube> chains = {Chain({Cyl(node + 0.30 * Dir(180), node + 0.025 * Dir(180), 0)}),
+                                    Chain({Cyl(node + 0.025 * Dir(130), node + 0.15 * Dir(130), 1)}),
+                                    Chain({Cyl(node + 0.19 * Dir(280), node + 0.09 * Dir(280), 2)})};
+  auto join = [&](double tube_length) {
+    return JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, {}, tube_length);
+  };
+  EXPECT_EQ(join(0.0).tubes.size(), 2u);  // no completion without the tube length
+  const JunctionJoining joined = join(0.75);
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  const std::vector<std::uint32_t> degree = NodeDegrees(joined.tubes[0]);
+  EXPECT_EQ(std::count(degree.begin(), degree.end(), 3u), 1);  // the link's node is a Y now
+  EXPECT_LT((joined.tubes[0].nodes[std::find(degree.begin(), degree.end(), 3u) - degree.begin()].p_Bin - node)
+                .norm(),
+            0.01);
+  ASSERT_EQ(joined.decisions.size(), 2u);
+  EXPECT_EQ(joined.decisions[0].kind, JoinDecision::Kind::kLink);
+  EXPECT_EQ(joined.decisions[1].kind, JoinDecision::Kind::kCompletionNode);
+  EXPECT_EQ(joined.decisions[1].chains, (std::vector<std::uint32_t>{2, 0}));
+  EXPECT_EQ(joined.completions, 1u);
+  EXPECT_EQ(joined.y_pieces, 0u);  // a completion never makes a scene look branched
+  EXPECT_EQ(joined.junctions, 0u);
+  // Within the tube length only: 0.275 + 0.125 + 0.10 + the links (0.025 + 0.025 + 0.09), 0.64 m.
+  EXPECT_EQ(join(0.62).tubes.size(), 2u);
+  EXPECT_EQ(join(0.66).tubes.size(), 1u);
+}
+
+TEST(JunctionJoining, ASecondBranchJoinsATeeNodeInTheCompletion) {
+  // A T-piece: a run along x, a branch along y ending 3 cm from the run's axis at x = 0.16. A third
+  // chain comes in along the run from +x, 1.8 cm above its axis, its end 5 cm short of the node:
+  // parallel to the run, it is no T-piece of it, but its axis meets the branch's within the
+  // completion's 2 cm (not the 1.6 cm of a link).
+  const Eigen::Vector3d foot(0.16, 0, kR);
+  const Eigen::Vector3d above(0, 0, 0.018);
+  const std::vector<Tube> chains = {
+      Chain({Cyl({0, 0, kR}, {0.30, 0, kR}, 0)}),
+      Chain({Cyl(foot + 0.13 * Dir(90), foot + 0.03 * Dir(90), 1)}),
+      Chain({Cyl(foot + above + 0.20 * Dir(0), foot + above + 0.05 * Dir(0), 2)})};
+  const JunctionJoining joined =
+      JoinJunctions(chains, JunctionParams{}, JunctionShape::kAny, nullptr, {}, 0.75);
+  ASSERT_EQ(joined.tubes.size(), 1u);
+  const std::vector<std::uint32_t> degree = NodeDegrees(joined.tubes[0]);
+  EXPECT_EQ(std::count(degree.begin(), degree.end(), 4u), 1);  // the T-node takes a fourth branch
+  ASSERT_EQ(joined.decisions.size(), 2u);
+  EXPECT_EQ(joined.decisions[0].kind, JoinDecision::Kind::kTPiece);
+  EXPECT_EQ(joined.decisions[1].kind, JoinDecision::Kind::kCompletionNode);
+  EXPECT_EQ(joined.decisions[1].chains, (std::vector<std::uint32_t>{2, 1}));
+  EXPECT_EQ(joined.junctions, 1u);
+  // A junction shape allows three branches at a node.
+  EXPECT_EQ(JoinJunctions(chains, JunctionParams{}, JunctionShape::kTee, nullptr, {}, 0.75).tubes.size(), 2u);
+}
+
 // A run along x with a branch at `branch_degrees` from it, ending 3 cm from the run's axis.
 std::vector<Tube> BranchOffARun(double branch_degrees) {
   const Eigen::Vector3d foot(0.16, 0, kR);
