@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "tests/service_test_support.h"
+#include "wire/status_names.h"
 
 namespace tubepick::service_test {
 namespace {
@@ -195,11 +196,13 @@ TEST(ServiceConcurrency, SeveralClientsAtOnceGetTheSameAnswers) {
   v1::ModelTubesResponse reference;
   ASSERT_TRUE(Model(server.stub(), std::chrono::seconds(30), &reference).ok());
   constexpr int kClients = 4, kCallsEach = 3;
-  std::vector<std::future<int>> clients;
+  // Per client: the calls answered as the reference was, and what went wrong with the others.
+  std::vector<std::future<std::pair<int, std::string>>> clients;
   for (int c = 0; c < kClients; ++c) {
     clients.push_back(std::async(std::launch::async, [&] {
       auto stub = server.NewStub();  // its own connection
       int same = 0;
+      std::string failures;
       for (int i = 0; i < kCallsEach; ++i) {
         v1::ModelTubesResponse r;
         const grpc::Status s = Model(*stub, std::chrono::seconds(60), &r);
@@ -207,11 +210,19 @@ TEST(ServiceConcurrency, SeveralClientsAtOnceGetTheSameAnswers) {
         for (int t = 0; equal && t < r.tubes_size(); ++t)
           equal = r.tubes(t).length() == reference.tubes(t).length();
         same += equal ? 1 : 0;
+        if (!s.ok())
+          failures += " [call " + std::to_string(i) + ": " + StatusCodeName(s.error_code()) + " " +
+                      s.error_message() + "]";
+        else if (!equal)
+          failures += " [call " + std::to_string(i) + ": " + std::to_string(r.tubes_size()) + " tubes]";
       }
-      return same;
+      return std::make_pair(same, failures);
     }));
   }
-  for (auto& c : clients) EXPECT_EQ(c.get(), kCallsEach);
+  for (auto& c : clients) {
+    const auto [same, failures] = c.get();
+    EXPECT_EQ(same, kCallsEach) << failures;
+  }
   EXPECT_EQ(server.server().calls_served(), 1u + kClients * kCallsEach);
   EXPECT_EQ(Metric(server, "tubepick_rpc_requests_total{method=\"ModelTubes\",code=\"OK\"}"),
             1.0 + kClients * kCallsEach);
