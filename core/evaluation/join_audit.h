@@ -25,7 +25,7 @@ struct JoinAudit {
     JoinTally refused;
   };
   /// Indexed by JoinDecision::Kind.
-  std::array<Kind, 6> kinds{};
+  std::array<Kind, JoinDecision::kKinds> kinds{};
   /// The linear chains junction joining started from, and those of them whose segments are mostly
   /// different real tubes (the linear joining before the junctions joined two tubes).
   std::uint32_t chains = 0;

@@ -257,6 +257,8 @@ void JunctionCompletionParams::Validate(const char* prefix) const {
   RequirePositive(max_length_share, p + ".max_length_share");
 }
 
+static_assert(static_cast<std::size_t>(JoinDecision::Kind::kCompletionNode) + 1 == JoinDecision::kKinds);
+
 std::string ToString(JoinDecision::Kind kind) {
   switch (kind) {
     case JoinDecision::Kind::kYPiece:

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -173,6 +174,8 @@ struct JoinDecision {
   /// kCompletionNode: a free end joined to the node where a completion pair's other end already
   /// is (a Y-piece's or link's meeting, or a T-node), as one more branch.
   enum class Kind { kYPiece, kTPiece, kLink, kCompletionT, kCompletionLink, kCompletionNode };
+  /// How many kinds there are (Kind's values are 0 .. kKinds − 1).
+  static constexpr std::size_t kKinds = 6;
   Kind kind = Kind::kYPiece;
   /// False: taken back because the tree it made does not fit the part's junction layout.
   bool accepted = true;
