@@ -75,6 +75,14 @@ class Forest {
   std::vector<double> length_;
 };
 
+// The arms of free ends meeting at a node: the directions from the node along their chains.
+std::vector<Eigen::Vector3d> ArmsOf(const std::vector<std::pair<std::uint32_t, bool>>& ends,
+                                    const std::vector<Tube>& chains) {
+  std::vector<Eigen::Vector3d> arms;
+  for (const auto& [chain, at_end] : ends) arms.push_back(-FreeEndOf(chains[chain], at_end).out);
+  return arms;
+}
+
 // A Y-piece's node with a junction shape: the three of its ends whose arms fit the shape best,
 // or nullopt when none fit within shape_tolerance (a chance end among them, or no Y at all).
 std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<Tube>& chains,
@@ -87,9 +95,7 @@ std::optional<MeetingNode> FittingEnds(const MeetingNode& n, const std::vector<T
     for (std::size_t b = a + 1; b < k; ++b) {
       for (std::size_t c = b + 1; c < k; ++c) {
         const std::vector<std::pair<std::uint32_t, bool>> ends = {n.ends[a], n.ends[b], n.ends[c]};
-        std::vector<Eigen::Vector3d> arms;
-        for (const auto& [chain, at_end] : ends) arms.push_back(-FreeEndOf(chains[chain], at_end).out);
-        const double deviation = ShapeDeviation(arms, shape);
+        const double deviation = ShapeDeviation(ArmsOf(ends, chains), shape);
         if (deviation > best_deviation) continue;
         best_deviation = deviation;
         best = n;
@@ -341,12 +347,17 @@ class Acceptance {
       nodes.push_back(HostNode{j.host_arc, j.host_position, j.p_Bin, 2});
       near = nodes.end() - 1;
     }
-    ++near->degree;
+    AddJunction(j, static_cast<std::size_t>(near - nodes.begin()), link);
+    return true;
+  }
+
+  // Junction `j` at node `node` of its host (nodes_of_host[j.host]), its branch linked `link` away.
+  void AddJunction(const Junction& j, std::size_t node, double link) {
+    ++state_.out.nodes_of_host[j.host][node].degree;
     Use(j.branch, j.at_end);
     state_.forest.Unite(j.branch, j.host, link);
     state_.out.junctions.push_back(j);
-    state_.out.node_of_junction.push_back(static_cast<std::size_t>(near - nodes.begin()));
-    return true;
+    state_.out.node_of_junction.push_back(node);
   }
 
   // `free` joins the node `at_node` is at: a Y-piece or link (one more end of the meeting) or a
@@ -365,10 +376,9 @@ class Acceptance {
       if (std::find(n.ends.begin(), n.ends.end(), at_node) == n.ends.end()) continue;
       if (n.ends.size() + 1 > max_branches || !within(n.Centre())) return false;
       if (shape_ != JunctionShape::kAny && n.ends.size() + 1 == 3) {
-        std::vector<Eigen::Vector3d> arms;
-        for (const auto& [chain, at_end] : n.ends) arms.push_back(-FreeEndOf(chains_[chain], at_end).out);
-        arms.push_back(-FreeEndOf(chains_[free.first], free.second).out);
-        if (ShapeDeviation(arms, shape_) > params_.shape_tolerance) return false;
+        std::vector<std::pair<std::uint32_t, bool>> ends = n.ends;
+        ends.push_back(free);
+        if (ShapeDeviation(ArmsOf(ends, chains_), shape_) > params_.shape_tolerance) return false;
       }
       state_.forest.Unite(n.ends.front().first, free.first, (n.Centre() - p_free).norm());
       n.ends.push_back(free);
@@ -378,16 +388,13 @@ class Acceptance {
     for (std::size_t i = 0; i < state_.out.junctions.size(); ++i) {
       const Junction& j = state_.out.junctions[i];
       if (j.branch != at_node.first || j.at_end != at_node.second) continue;
-      HostNode& node = state_.out.nodes_of_host[j.host][state_.out.node_of_junction[i]];
-      if (node.degree + 1 > max_branches || !within(node.p_Bin)) return false;
-      Junction added = j;
+      const std::size_t node = state_.out.node_of_junction[i];
+      const HostNode& host_node = state_.out.nodes_of_host[j.host][node];
+      if (host_node.degree + 1 > max_branches || !within(host_node.p_Bin)) return false;
+      Junction added = j;  // a copy: AddJunction appends to the vector j is in
       added.branch = free.first;
       added.at_end = free.second;
-      ++node.degree;
-      Use(free.first, free.second);
-      state_.forest.Unite(free.first, j.host, (node.p_Bin - p_free).norm());
-      state_.out.junctions.push_back(added);
-      state_.out.node_of_junction.push_back(state_.out.node_of_junction[i]);
+      AddJunction(added, node, (host_node.p_Bin - p_free).norm());
       return true;
     }
     return false;

@@ -367,9 +367,9 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
     completion.sides = FindJunctions(chains, wide, shape, rooms);
     completion.pairs = FindEndMeetings(chains, wide, rooms);
   }
-  const Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
-                                   FindJunctions(chains, params, shape, rooms), completion, max_tree_length,
-                                   max_completed_length, params, shape, layout, stop);
+  Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
+                             FindJunctions(chains, params, shape, rooms), completion, max_tree_length,
+                             max_completed_length, params, shape, layout, stop);
   JunctionJoining out;
   for (const JoinDecision& d : accepted.decisions) {
     if (!d.accepted) continue;
@@ -390,7 +390,7 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
         break;
     }
   }
-  out.decisions = accepted.decisions;
+  out.decisions = std::move(accepted.decisions);
 
   // Components (by the smallest chain index in them), in order of that index.
   std::vector<std::uint32_t> component(chains.size());

@@ -90,7 +90,7 @@ JoinedTubes JoinModeledTubes(const ModelingInput& input, const ModelingParams& p
     JoiningParams chain_joining = params.joining;
     chain_joining.max_distance = std::min(chain_joining.max_distance, params.junctions.chain_max_distance);
     chain_joining.max_angle = std::min(chain_joining.max_angle, params.junctions.chain_max_angle);
-    const std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
+    std::vector<Tube> chains = JoinTubes(cylinders, chain_joining, seen, stop);
     const EndRooms rooms =
         MeasureEndRooms(UnfittedPoints(filtered, inliers_of), chains, params.junctions.end_room, seen);
     JunctionJoining joined = JoinJunctionsOfLength(chains, params.junctions, input.junction_shape, stop,
@@ -102,7 +102,7 @@ JoinedTubes JoinModeledTubes(const ModelingInput& input, const ModelingParams& p
         joined.tubes.size(), ToString(input.topology), out.trees ? "branched" : "linear");
     if (out.trees) {
       out.tubes = std::move(joined.tubes);
-      out.chains = chains;
+      out.chains = std::move(chains);
       out.decisions = std::move(joined.decisions);
       return out;
     }
