@@ -225,6 +225,8 @@ std::uint32_t SimCell::TubesElsewhere() const {
 
 double SimCell::SimulatedSeconds() const { return impl_->state.world->time() - impl_->state.start_time; }
 
+std::uint32_t SimCell::AwakeTubeBodies() const { return impl_->state.world->AwakeTubeBodies(); }
+
 std::vector<physics::TubeGeometry> SimCell::TubesBin() const { return impl_->state.world->TubesBin(); }
 
 std::vector<Eigen::Vector3d> SimCell::TubeCentresOfMass() const {

@@ -285,6 +285,9 @@ class SimCell {
   std::uint32_t TubesElsewhere() const;
   /// Simulated seconds since construction (the initial drop and settling not counted).
   double SimulatedSeconds() const;
+  /// Tube bodies (a pvc tube, a rubber tube's link) Bullet still steps: a heap at rest falls
+  /// asleep, and costs next to nothing, until something touches it.
+  std::uint32_t AwakeTubeBodies() const;
 
   /// Ground truth: every tube as it is now, bin frame, in construction order (ids 1..N). A
   /// rubber tube's nodes are its chain's joints.

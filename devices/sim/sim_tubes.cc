@@ -21,6 +21,8 @@ struct BodyShape {
   btVector3 inertia{0, 0, 0};
   Eigen::Isometry3d X_BinC = Eigen::Isometry3d::Identity();
   double radius = 0.0;
+  /// The farthest point of its surface from its centre of mass, metres.
+  double reach = 0.0;
 };
 
 /// The compound of physics::MakeTubeShape (capsules, flat free ends).
@@ -28,7 +30,7 @@ BodyShape CompoundShape(physics::BulletWorld& world, const std::vector<physics::
                         double mass, double margin) {
   world.tube_shapes.push_back(physics::MakeTubeShape(segments, mass, margin));
   const physics::TubeShape& s = world.tube_shapes.back();
-  return {s.compound.get(), s.inertia, s.X_TubeC, s.radius};
+  return {s.compound.get(), s.inertia, s.X_TubeC, s.radius, s.reach};
 }
 
 btRigidBody* AddBody(physics::BulletWorld& world, const BodyShape& s, double mass,
@@ -41,7 +43,10 @@ btRigidBody* AddBody(physics::BulletWorld& world, const BodyShape& s, double mas
   info.m_linearDamping = options.linear_damping;
   info.m_angularDamping = options.angular_damping;
   info.m_linearSleepingThreshold = options.sleep_linear_velocity;
-  info.m_angularSleepingThreshold = options.sleep_angular_velocity;
+  info.m_angularSleepingThreshold =
+      options.rubber && s.reach > 0.0
+          ? std::max(options.sleep_angular_velocity, options.sleep_linear_velocity / s.reach)
+          : options.sleep_angular_velocity;
   btRigidBody* body = world.AddBody(info);
   // Continuous collision: a swept sphere inside the tube whenever a step moves it more than R.
   body->setCcdMotionThreshold(s.radius);

@@ -51,7 +51,14 @@ struct TubeBodyOptions {
   double body_friction = 0.5;
   double body_restitution = 0.3;
   double collision_margin = 0.001;
+  /// Bullet's sleeping thresholds: a body whose speeds stay below them for 2 s sleeps (until
+  /// something touches it). m/s, rad/s.
   double sleep_linear_velocity = 0.02;
+  /// A rubber link takes sleep_linear_velocity over its reach (the farthest point of its surface
+  /// from its centre of mass) when that is larger: turning at it, no point of the link moves faster
+  /// than a link may slide and still sleep (0.57 rad/s for 5 cm links of 1 cm radius). Links this
+  /// light are spun about their own axis by contact noise at 0.2-0.5 rad/s (their surface moving
+  /// at millimetres a second), which kept whole piles of hoses awake.
   double sleep_angular_velocity = 0.2;
   double linear_damping = 0.05;
   double angular_damping = 0.2;

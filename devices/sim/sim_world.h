@@ -88,6 +88,8 @@ class SimWorld {
   /// Tubes with a held link, ascending.
   std::vector<std::size_t> HeldTubes() const;
   bool holding() const { return !grasps_.empty(); }
+  /// Bodies of the tubes still in the world that Bullet steps (not asleep).
+  std::uint32_t AwakeTubeBodies() const;
 
   std::size_t tube_count() const { return tubes_.size(); }
   /// Every tube where it is (a carried-off tube where it was carried off), by index.

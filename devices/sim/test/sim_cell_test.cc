@@ -128,6 +128,37 @@ TEST(SimCell, BranchedTreesAreRigidInPvcAndJointedChainsInRubber) {
   }
 }
 
+TEST(SimCell, AHeapOfHosesAtRestFallsAsleepUntilTheToolTouchesIt) {
+  // Ten rubber trees, 150 links of 7 g: contact noise spun links about their own axes at 0.2-0.5
+  // rad/s, above the sleeping threshold, and kept the whole heap awake (every step simulated).
+  SimCellParams params = SimCellParams::Thesis(Material::kRubber, 10, 1);
+  params.tube_shape = physics::RandomTubeParams::SetC();
+  params.tube_shape->radius = params.cell.tube.radius;
+  SimCell cell(params);
+  ASSERT_EQ(cell.TubesInBin(), 10u);
+  cell.Advance(3.0);
+  EXPECT_EQ(cell.AwakeTubeBodies(), 0u);
+
+  // The gripper closes on the heap's highest link: what it touches wakes, and with it the heap
+  // that link rests on.
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  for (const physics::TubeGeometry& tree : cell.TubesBin()) {
+    for (const physics::TubeEdge& edge : tree.edges) {
+      const Eigen::Vector3d p = tree.Node(edge.node1).centre, q = tree.Node(edge.node2).centre;
+      if (p.z() + q.z() > a.z() + b.z()) a = p, b = q;
+    }
+  }
+  const Eigen::Isometry3d X_grasp = *GraspFrame(0.5 * (a + b), b - a);
+  cell.robot().ServoOn(kLong);
+  cell.robot().MoveTo(Raised(X_grasp, 0.1), 0.25, kLong);
+  EXPECT_EQ(cell.AwakeTubeBodies(), 0u);  // 10 cm above it
+  EXPECT_EQ(Grasp(cell, X_grasp).object, GripperObject::kStoppedClosing);
+  EXPECT_EQ(cell.HeldTubes().size(), 1u);
+  cell.Advance(0.05);
+  EXPECT_GT(cell.AwakeTubeBodies(), 10u);
+  EXPECT_EQ(cell.TubesInBin(), 10u);
+}
+
 TEST(SimCell, IsolatedTubeLiftReadsItsWeightAndPlacesOutside) {
   SimCellParams params;
   params.seed = 4;
