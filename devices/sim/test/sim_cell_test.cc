@@ -1,6 +1,7 @@
 #include "devices/sim/sim_cell.h"
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -75,10 +76,16 @@ TEST(SimCell, ConstructionDropsEveryTubeIntoTheBin) {
   }
 }
 
-TEST(SimCell, BranchedTreesAreRigidInPvcAndJointedChainsInRubber) {
-  SimCellParams params = SimCellParams::Thesis(Material::kPvc, 3, 5);
+/// The thesis cell with `trees` set-C trees (as published) of `material`.
+SimCellParams TreeCell(Material material, std::uint32_t trees, std::uint64_t seed) {
+  SimCellParams params = SimCellParams::Thesis(material, trees, seed);
   params.tube_shape = physics::RandomTubeParams::SetC();
   params.tube_shape->radius = params.cell.tube.radius;
+  return params;
+}
+
+TEST(SimCell, BranchedTreesAreRigidInPvcAndJointedChainsInRubber) {
+  SimCellParams params = TreeCell(Material::kPvc, 3, 5);
   SimCell cell(params);
   EXPECT_EQ(cell.TubesInBin(), 3u);
   const std::vector<physics::TubeGeometry> before = cell.TubesBin();
@@ -131,10 +138,7 @@ TEST(SimCell, BranchedTreesAreRigidInPvcAndJointedChainsInRubber) {
 TEST(SimCell, AHeapOfHosesAtRestFallsAsleepUntilTheToolTouchesIt) {
   // Ten rubber trees, 150 links of 7 g: contact noise spun links about their own axes at 0.2-0.5
   // rad/s, above the sleeping threshold, and kept the whole heap awake (every step simulated).
-  SimCellParams params = SimCellParams::Thesis(Material::kRubber, 10, 1);
-  params.tube_shape = physics::RandomTubeParams::SetC();
-  params.tube_shape->radius = params.cell.tube.radius;
-  SimCell cell(params);
+  SimCell cell(TreeCell(Material::kRubber, 10, 1));
   ASSERT_EQ(cell.TubesInBin(), 10u);
   cell.Advance(3.0);
   EXPECT_EQ(cell.AwakeTubeBodies(), 0u);
