@@ -49,6 +49,12 @@ class Robot {
   /// Moves through relative translations of the TCP (bin axes), first (0,0,0), at `speed`.
   /// @throws DeviceTimeout, DeviceFault.
   virtual void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) = 0;
+  /// Keeps the TCP where it is for `seconds` while what hangs from the tool swings and slides (a
+  /// resolution rotation's pause at its tilt). A real arm holds its pose with its servos on, so the
+  /// default waits on the wall clock; a simulated arm advances its simulation instead.
+  /// @throws DeviceFault when `seconds` is negative or not finite; DeviceTimeout when it exceeds
+  /// `timeout` (after waiting `timeout`).
+  virtual void Hold(double seconds, Timeout timeout);
   /// @throws DeviceTimeout, DeviceFault.
   virtual Eigen::Isometry3d CurrentPose(Timeout timeout) = 0;
   /// Servo power on. @throws DeviceTimeout, DeviceFault.

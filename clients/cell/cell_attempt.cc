@@ -258,8 +258,8 @@ std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOu
 }
 
 /// Several tubes: carried over the bin's middle (resolution_hold_over_bin), then the resolution
-/// motions in order there, each followed by a new reading at the hold pose; unresolved, back to the
-/// lift pose and put back.
+/// motions in order there, each paused at its tilt (resolution_dwell) and followed by a new reading
+/// at the hold pose; unresolved, back to the lift pose and put back.
 CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchResponse& analysis,
                                                       const devices::WrenchReading& reference,
                                                       const devices::WrenchReading& lifted,
@@ -337,6 +337,7 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
                             fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
     MoveTo(X_BinTcpWaypoint, params_.resolution_speed, &attempt);
   }
+  if (params_.resolution_dwell > 0.0) HoldStill(params_.resolution_dwell, &attempt);
   MoveTo(X_BinTcpHold, params_.resolution_speed, &attempt);
   CheckStillHolding("resolve", attempt);
   *after = ReadWrench();

@@ -493,6 +493,8 @@ class CellController {
   void TimedRobotMotion(Attempt* attempt, const Motion& motion);
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Attempt* attempt);
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_Bin, double speed, Attempt* attempt);
+  /// Robot::Hold for `seconds` (the robot's time of the attempt counts it).
+  void HoldStill(double seconds, Attempt* attempt);
   Eigen::Isometry3d CurrentPose();
   /// The poses TransitTo moves through from X_BinTcpFrom: up to transit height (if below it),
   /// across, down to X_BinTcpTo (if below it); the last is X_BinTcpTo.

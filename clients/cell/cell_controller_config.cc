@@ -117,6 +117,7 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("resolution_hold_over_bin", p.resolution_hold_over_bin,
     "carry several tubes over the bin's middle before the resolution rotation");
   v("resolution_wall_margin", p.resolution_wall_margin, "m, the TCP inside the bin walls while it does");
+  v("resolution_dwell", p.resolution_dwell, "s, each resolution motion pauses at its tilt; 0 = none");
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");

@@ -50,6 +50,7 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(lift_speed, "lift_speed");
   RequirePositiveValue(resolution_speed, "resolution_speed");
   RequireNonNegativeValue(resolution_wall_margin, "resolution_wall_margin");
+  RequireNonNegativeValue(resolution_dwell, "resolution_dwell");
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");
@@ -108,6 +109,11 @@ void CellControllerParams::Validate() const {
   RequirePositiveCount(max_consecutive_failures, "max_consecutive_failures");
   RequirePositiveDuration(scanner_timeout, "scanner_timeout");
   RequirePositiveDuration(robot_timeout, "robot_timeout");
+  if (resolution_dwell >= std::chrono::duration<double>(robot_timeout).count())
+    throw InvalidArgument(
+        fmt::format("cell controller resolution_dwell: {} s is not below robot_timeout ({} s): the pause is "
+                    "one robot call",
+                    resolution_dwell, std::chrono::duration<double>(robot_timeout).count()));
   RequirePositiveDuration(gripper_timeout, "gripper_timeout");
   RequirePositiveDuration(ft_timeout, "ft_timeout");
 }

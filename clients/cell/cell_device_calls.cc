@@ -132,6 +132,10 @@ void CellController::MoveThrough(const std::vector<Eigen::Vector3d>& waypoints_B
                    [&] { devices_.robot->MoveThrough(waypoints_Bin, speed, params_.robot_timeout); });
 }
 
+void CellController::HoldStill(double seconds, Attempt* attempt) {
+  TimedRobotMotion(attempt, [&] { devices_.robot->Hold(seconds, params_.robot_timeout); });
+}
+
 Eigen::Isometry3d CellController::CurrentPose() {
   return CallDevice("robot", state_, [&] { return devices_.robot->CurrentPose(params_.robot_timeout); });
 }

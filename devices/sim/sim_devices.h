@@ -82,6 +82,8 @@ class SimRobot final : public Robot {
   explicit SimRobot(SimCellState& state) : state_(state) {}
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Timeout timeout) override;
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) override;
+  /// The simulation advances `seconds` with the tool still (injected slips and alarms tick on).
+  void Hold(double seconds, Timeout timeout) override;
   Eigen::Isometry3d CurrentPose(Timeout timeout) override;
   void ServoOn(Timeout timeout) override;
   std::optional<RobotStatus> Status(Timeout timeout) override;

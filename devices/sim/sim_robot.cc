@@ -158,6 +158,23 @@ std::optional<RobotStatus> SimRobot::Status(Timeout /*timeout*/) {
   return status;
 }
 
+void SimRobot::Hold(double seconds, Timeout timeout) {
+  CheckReady();
+  if (!std::isfinite(seconds) || seconds < 0.0)
+    throw DeviceFault(fmt::format("robot: hold for {} s (a wait, at least 0)", seconds));
+  SimWorld& world = *state_.world;
+  const double dt = world.substep();
+  const double held = std::min(seconds, Seconds(timeout));
+  for (int k = static_cast<int>(std::ceil(held / dt - 1e-9)); k > 0; --k) {
+    world.Step();
+    state_.TickSlip(dt);
+    state_.TickRobotAlarm(dt);
+  }
+  if (seconds > Seconds(timeout))
+    throw DeviceTimeout(
+        fmt::format("robot: a hold of {:.2f} s exceeds the timeout of {:.3f} s", seconds, Seconds(timeout)));
+}
+
 void SimRobot::ServoOn(Timeout /*timeout*/) {
   state_.ThrowIfInjected(SimDevice::kRobot, "robot");
   state_.servo_on = true;

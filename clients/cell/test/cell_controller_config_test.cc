@@ -21,6 +21,7 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.resolution_speed, b.resolution_speed);
   EXPECT_EQ(a.resolution_hold_over_bin, b.resolution_hold_over_bin);
   EXPECT_EQ(a.resolution_wall_margin, b.resolution_wall_margin);
+  EXPECT_EQ(a.resolution_dwell, b.resolution_dwell);
   EXPECT_EQ(a.approach_height, b.approach_height);
   EXPECT_EQ(a.transit_clearance, b.transit_clearance);
   EXPECT_EQ(a.release_height, b.release_height);
@@ -132,6 +133,7 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.resolution_speed = 0.12;
   p.resolution_hold_over_bin = false;
   p.resolution_wall_margin = 0.09;
+  p.resolution_dwell = 0.25;
   p.approach_height = 0.13;
   p.transit_clearance = 0.31;
   p.place_approach_height = 0.14;
@@ -227,6 +229,14 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
   EXPECT_NE(ParseError("max_attempts_per_bin: 0\n").find("max_attempts_per_bin: must be at least 1, got 0"),
             std::string::npos);
   EXPECT_NE(ParseError("robot_timeout: 0\n").find("robot_timeout: must be positive"), std::string::npos);
+  EXPECT_NE(
+      ParseError("resolution_dwell: -1\n").find("resolution_dwell: must be a non-negative number, got -1"),
+      std::string::npos);
+  // The pause is one robot call: it must end within the robot's timeout.
+  EXPECT_NE(ParseError("resolution_dwell: 5\nrobot_timeout: 5\n")
+                .find("resolution_dwell: 5 s is not below robot_timeout (5 s)"),
+            std::string::npos)
+      << ParseError("resolution_dwell: 5\nrobot_timeout: 5\n");
   EXPECT_NE(ParseError("failed_grasp_radius: -0.01\n")
                 .find("failed_grasp_radius: must be a finite distance >= 0 m (0 = off), got -0.01"),
             std::string::npos)

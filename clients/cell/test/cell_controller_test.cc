@@ -517,6 +517,12 @@ TEST_F(CellControllerTest, MultipleThenResolutionLeavesOneTubeWhichIsPlaced) {
   EXPECT_DOUBLE_EQ(robot.moves[tilted_index - 1].speed, params.lift_speed);
   EXPECT_TRUE(robot.moves[tilted_index + 1].X_BinTcpTarget.isApprox(shift * X_BinTcpLift, kTol));
   EXPECT_DOUBLE_EQ(robot.moves[tilted_index].speed, params.resolution_speed);
+  // It paused at the tilt (resolution_dwell) before turning back, and nowhere else.
+  ASSERT_EQ(robot.holds.size(), 1u);
+  EXPECT_TRUE(robot.holds[0].X_BinTcp.isApprox(shift * X_BinTcpTilted, kTol));
+  EXPECT_EQ(robot.holds[0].after_moves, static_cast<std::size_t>(tilted_index) + 1);
+  EXPECT_DOUBLE_EQ(robot.holds[0].seconds, params.resolution_dwell);
+  EXPECT_GT(params.resolution_dwell, 0.0);
   EXPECT_TRUE(robot.Visited(DownPose(Eigen::Vector3d(0.0, 0.8, 0.12))));
   // The second analysis used the same reference and the new reading at the lift pose.
   ASSERT_EQ(planner.wrench_requests.size(), 2u);
@@ -567,13 +573,15 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
                             Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9)};
   ft.held_force = 2.0 * 1.08;  // two tubes' weight hangs on the tool ...
   ft.tcp = &robot.X_BinTcp;
-  ft.rests_below_z = 0.25;  // ... until the heap takes it
+  ft.rests_below_z = 0.25;        // ... until the heap takes it
+  params.resolution_dwell = 0.0;  // turns back at once
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty);
   EXPECT_EQ(result.picks, 0u);
   EXPECT_EQ(result.scans, 2u);
   EXPECT_EQ(planner.wrench_requests.size(), 3u);
+  EXPECT_TRUE(robot.holds.empty());
   // Its centre of mass well inside the walls (no torque): lowered where it was lifted, straight down
   // in put_back_step steps reading the F/T (what hangs under the tube grasped meets the heap before
   // the grasp height), opened where the heap takes the load (0.25 m up here), back up.
@@ -628,6 +636,9 @@ TEST_F(CellControllerTest, AResolutionMotionBeyondTheWristLimitIsSkippedNotDrive
   EXPECT_EQ(result.picks, 1u) << result.message;
   EXPECT_FALSE(robot.Visited(X_BinTcpFar));
   EXPECT_TRUE(robot.Visited(X_BinTcpNear));
+  // The pause at the tilt only where the tool went: not for the motion skipped.
+  ASSERT_EQ(robot.holds.size(), 1u);
+  EXPECT_TRUE(robot.holds[0].X_BinTcp.isApprox(X_BinTcpNear, kTol));
   EXPECT_EQ(planner.wrench_requests.size(), 2u);
   const json a = Records("attempt").at(0);
   ASSERT_EQ(a["resolution"]["beyond_limits"].size(), 1u);

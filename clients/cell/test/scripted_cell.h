@@ -104,6 +104,18 @@ class ScriptedRobot final : public devices::Robot {
     moves.push_back({true, X_BinTcpTarget, waypoints_Bin, speed});
     X_BinTcp = X_BinTcpTarget;
   }
+  /// A Hold: where, how long, and how many moves came before it.
+  struct HoldCall {
+    Eigen::Isometry3d X_BinTcp = Eigen::Isometry3d::Identity();
+    double seconds = 0.0;
+    std::size_t after_moves = 0;
+  };
+  std::vector<HoldCall> holds;
+  void Hold(double seconds, devices::Timeout) override {
+    if (forbid_motion) ADD_FAILURE() << "Robot::Hold called";
+    if (fail_always) failure.Throw();
+    holds.push_back({X_BinTcp, seconds, moves.size()});
+  }
   Eigen::Isometry3d CurrentPose(devices::Timeout) override { return X_BinTcp; }
   void ServoOn(devices::Timeout) override {
     if (forbid_motion) ADD_FAILURE() << "Robot::ServoOn called";

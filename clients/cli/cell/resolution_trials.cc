@@ -81,7 +81,7 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
     ++trial.motions_used;
     for (const ResolutionWaypoint& w : motion.waypoints)
       cell.robot().MoveTo(shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
-    if (tp.dwell > 0.0) cell.Advance(tp.dwell);
+    if (c.resolution_dwell > 0.0) cell.robot().Hold(c.resolution_dwell, kLong);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     *held = AsWrench(cell.ft_sensor().Read(kLong));
     const HeldCount again = CountHeldTubes(reference, *held, tube_mass, params);
@@ -395,10 +395,14 @@ void RunTrials(const ResolutionTrialsOptions& o) {
                    material_name, shapes, variant, angle, s.bins, s.lifts, s.multiple, s.freed,
                    Percent(s.freed, s.multiple), s.second_motion, s.put_back, s.moved_inside, s.caught,
                    s.outside, s.faults);
-        nlohmann::json arm = {{"material", material_name}, {"shapes", shapes},
-                              {"variant", variant},        {"angle_deg", angle},
-                              {"tubes", o.tubes},          {"lift", o.trial.lift},
-                              {"dwell", o.trial.dwell},    {"trials", nlohmann::json::array()}};
+        nlohmann::json arm = {{"material", material_name},
+                              {"shapes", shapes},
+                              {"variant", variant},
+                              {"angle_deg", angle},
+                              {"tubes", o.tubes},
+                              {"lift", o.trial.lift},
+                              {"dwell", o.trial.controller.resolution_dwell},
+                              {"trials", nlohmann::json::array()}};
         for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
         json.push_back(arm);
       }
@@ -431,8 +435,9 @@ void ValidateResolutionTrials(const ResolutionTrialsOptions& o) {
   if (!(o.trial.lift > 0.0))
     throw InvalidArgument(
         fmt::format("--lift: {} m (the lift before the reading must be positive)", o.trial.lift));
-  if (!(o.trial.dwell >= 0.0))
-    throw InvalidArgument(fmt::format("--dwell: {} s (a wait, at least 0)", o.trial.dwell));
+  if (!(o.trial.controller.resolution_dwell >= 0.0))
+    throw InvalidArgument(
+        fmt::format("--dwell: {} s (a wait, at least 0)", o.trial.controller.resolution_dwell));
   if (!(o.trial.controller.put_back_margin >= 0.0))
     throw InvalidArgument(fmt::format("--put-back-margin: {} m (inside the bin walls, at least 0)",
                                       o.trial.controller.put_back_margin));
@@ -472,7 +477,8 @@ void AddResolutionTrialsCommand(CLI::App& app) {
   cmd->add_option("--wall-margin", o->trial.controller.resolution_wall_margin,
                   "The hold pose's TCP inside the bin walls, metres")
       ->capture_default_str();
-  cmd->add_option("--dwell", o->trial.dwell, "Wait at the end of each resolution motion, seconds")
+  cmd->add_option("--dwell", o->trial.controller.resolution_dwell,
+                  "Pause at each resolution motion's tilt, seconds (the controller's resolution_dwell)")
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")

@@ -70,13 +70,12 @@ struct TrialParams {
   double lift = TrajectoryParams{}.upward_distance;
   /// Lifts per bin until one holds several tubes.
   std::uint32_t max_lifts = 6;
-  /// Wait at the end of each resolution motion before the return to the hold pose, seconds.
-  double dwell = 0.0;
   /// Run the resolution on a double pick; false: put it back at once (measures the put-back alone).
   bool resolve = true;
-  /// The controller's speeds, approach and release heights and resolution hold
+  /// The controller's speeds, approach and release heights, resolution hold
   /// (resolution_hold_over_bin: the payload brought over the bin's middle, PlanResolutionHold,
-  /// before the rotation, the TCP resolution_wall_margin inside the walls).
+  /// before the rotation, the TCP resolution_wall_margin inside the walls) and the pause at each
+  /// motion's tilt (resolution_dwell).
   cell::CellControllerParams controller;
 };
 
@@ -85,11 +84,10 @@ struct TrialParams {
 /// F/T read there. A lift that holds one tube puts it back (lowered to 3 cm above the grasp,
 /// opened); the first that holds several (Algorithm 3) gets the resolution of `wrench`
 /// (WrenchParamsAtPose at the lift pose) at the hold pose (hold_over_bin), each motion at 0.1 m/s,
-/// a dwell and back to the hold pose, read again, until one tube is left, and ends the trial (put
-/// back as the controller puts back several tubes, put_back_margin and put_back_step, when none
-/// freed). Every
-/// variant meets the same double pick: the simulation is deterministic up to the resolution. Same
-/// params ⇒ same trial.
+/// a pause at the tilt (resolution_dwell) and back to the hold pose, read again, until one tube is left, and
+/// ends the trial (put back as the controller puts back several tubes, put_back_margin and put_back_step,
+/// when none freed). Every variant meets the same double pick: the simulation is deterministic up to the
+/// resolution. Same params ⇒ same trial.
 ResolutionTrial RunResolutionTrial(const devices::sim::SimCellParams& params, const WrenchParams& wrench,
                                    const TrialParams& trial_params);
 /// The same in a cell built by the caller (e.g. with explicit tubes).

@@ -247,6 +247,30 @@ TEST(SimCell, ArmedSlipDropsTheHeldTubeMidMotionAndTheGripperSaysSo) {
   EXPECT_EQ(cell.TubesElsewhere(), 0u);
 }
 
+TEST(SimCell, AHoldKeepsTheToolStillWhileTheSimulationRuns) {
+  SimCellParams params;
+  SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});
+  GraspAndLift(cell);
+  const Eigen::Isometry3d X_held = cell.X_BinTcp();
+  const double t0 = cell.SimulatedSeconds();
+  cell.ArmSlip(0.5);  // injected faults tick on while the arm holds still
+  cell.robot().Hold(1.0, kLong);
+  EXPECT_NEAR(cell.SimulatedSeconds() - t0, 1.0, params.physics.time_step);
+  EXPECT_TRUE(cell.X_BinTcp().isApprox(X_held, 1e-12));
+  EXPECT_EQ(cell.fault_events().slips, 1u);
+  EXPECT_TRUE(cell.HeldTubes().empty());
+  // The tube fell during the hold: half a second of falling from 0.3 m put it on the floor.
+  EXPECT_LT(cell.TubeCentresOfMass()[0].z(), 0.05);
+
+  EXPECT_THAT([&] { cell.robot().Hold(-1.0, kLong); },
+              ::testing::ThrowsMessage<DeviceFault>(HasSubstr("-1 s")));
+  EXPECT_THROW(cell.robot().Hold(std::nan(""), kLong), DeviceFault);
+  const double t1 = cell.SimulatedSeconds();
+  EXPECT_THAT([&] { cell.robot().Hold(2.0, Timeout(500)); },
+              ::testing::ThrowsMessage<DeviceTimeout>(HasSubstr("exceeds the timeout of 0.500 s")));
+  EXPECT_NEAR(cell.SimulatedSeconds() - t1, 0.5, params.physics.time_step);
+}
+
 TEST(SimCell, ASnaggedTubeStaysOnTheOpenToolUntilItOpensAgain) {
   SimCellParams params;
   SimCell cell(params, {StraightTube(1, params.cell.tube.radius, 0.5)});

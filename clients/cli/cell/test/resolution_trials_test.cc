@@ -122,7 +122,7 @@ TEST(ResolutionTrials, EveryBadOptionIsRefusedByNameBeforeATrialRuns) {
   EXPECT_THAT(with([](auto& o) { o.bins = 0; }), HasSubstr("--bins: 0"));
   EXPECT_THAT(with([](auto& o) { o.tubes = 1; }), HasSubstr("--tubes: 1"));
   EXPECT_THAT(with([](auto& o) { o.trial.lift = 0.0; }), HasSubstr("--lift: 0 m"));
-  EXPECT_THAT(with([](auto& o) { o.trial.dwell = -1.0; }), HasSubstr("--dwell: -1 s"));
+  EXPECT_THAT(with([](auto& o) { o.trial.controller.resolution_dwell = -1.0; }), HasSubstr("--dwell: -1 s"));
   EXPECT_THAT(with([](auto& o) { o.trial.controller.resolution_wall_margin = -0.1; }),
               HasSubstr("--wall-margin: -0.1 m"));
   EXPECT_THAT(with([](auto& o) { o.trial.controller.put_back_margin = -0.2; }),
