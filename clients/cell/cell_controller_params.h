@@ -51,8 +51,9 @@ struct CellControllerParams {
   double resolution_wall_margin = 0.15;
   /// Each resolution motion pauses this long at its tilt (Robot::Hold) before turning back, seconds:
   /// a hose with rubber's friction slides off the tilted tube slowly, and turning back at once
-  /// hooks it again. On generated rubber set-C bins (`tubepick resolution-trials --dwell`) 1.5 s
-  /// freed 8 of 12 double picks against 5 of 12 without. 0 = turn back at once (the thesis).
+  /// hooks it again. On generated set-C bins (`tubepick resolution-trials --dwell`) 1.5 s freed 11
+  /// of 24 rubber and 22 of 31 pvc double picks against 9 and 21 without, no tube more outside the
+  /// bin (docs/ACCURACY.md). 0 = turn back at once (the thesis).
   double resolution_dwell = 1.5;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
