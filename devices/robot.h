@@ -53,8 +53,8 @@ class Robot {
   /// resolution rotation's pause at its tilt). A real arm holds its pose with its servos on, so the
   /// default waits on the wall clock; a simulated arm advances its simulation instead.
   /// @throws DeviceFault when `seconds` is negative or not finite; DeviceTimeout when it exceeds
-  /// `timeout` (after waiting `timeout`).
-  virtual void Hold(double seconds, Timeout timeout);
+  /// `timeout` (after holding `timeout`). Drivers implement HoldFor.
+  void Hold(double seconds, Timeout timeout);
   /// @throws DeviceTimeout, DeviceFault.
   virtual Eigen::Isometry3d CurrentPose(Timeout timeout) = 0;
   /// Servo power on. @throws DeviceTimeout, DeviceFault.
@@ -64,6 +64,10 @@ class Robot {
   virtual std::optional<RobotStatus> Status(Timeout /*timeout*/) { return std::nullopt; }
   /// Reach, tilt and speed limits (from the driver's configuration; no device round trip).
   virtual RobotLimits Limits() const = 0;
+
+ protected:
+  /// Holds still for `seconds` (finite, >= 0, within the call's timeout: Hold checked them).
+  virtual void HoldFor(double seconds);
 };
 
 }  // namespace tubepick::devices

@@ -82,15 +82,19 @@ class SimRobot final : public Robot {
   explicit SimRobot(SimCellState& state) : state_(state) {}
   void MoveTo(const Eigen::Isometry3d& X_BinTcp, double speed, Timeout timeout) override;
   void MoveThrough(const std::vector<Eigen::Vector3d>& waypoints, double speed, Timeout timeout) override;
-  /// The simulation advances `seconds` with the tool still (injected slips and alarms tick on).
-  void Hold(double seconds, Timeout timeout) override;
   Eigen::Isometry3d CurrentPose(Timeout timeout) override;
   void ServoOn(Timeout timeout) override;
   std::optional<RobotStatus> Status(Timeout timeout) override;
   RobotLimits Limits() const override;
 
+ protected:
+  /// The simulation advances `seconds` with the tool still (injected slips and alarms tick on).
+  void HoldFor(double seconds) override;
+
  private:
   void CheckReady() const;
+  /// One Bullet substep with the tool where it was commanded; injected slips and alarms tick.
+  void Tick();
   /// DeviceFault unless X_BinTcp is a finite rigid pose inside the reach box within the tilt limit.
   void CheckTarget(const Eigen::Isometry3d& X_BinTcp) const;
   double EffectiveSpeed(double speed) const;

@@ -85,9 +85,7 @@ void SimRobot::Run(double length, double speed, const PoseAt& pose_at, const Eig
                       profile.duration(), Format(world.X_BinTcp().translation())));
     }
     world.SetGripper(k == steps ? X_BinTcp_end : pose_at(profile.DistanceAt(t)), world.opening());
-    world.Step();
-    state_.TickSlip(dt);
-    state_.TickRobotAlarm(dt);
+    Tick();
     if (k % world.substeps() == 0 || k == steps) {
       const GripperCollision collision = world.QueryCollision(true, housing_stop);
       if (!warned) {
@@ -158,21 +156,15 @@ std::optional<RobotStatus> SimRobot::Status(Timeout /*timeout*/) {
   return status;
 }
 
-void SimRobot::Hold(double seconds, Timeout timeout) {
+void SimRobot::Tick() {
+  state_.world->Step();
+  state_.TickSlip(state_.world->substep());
+  state_.TickRobotAlarm(state_.world->substep());
+}
+
+void SimRobot::HoldFor(double seconds) {
   CheckReady();
-  if (!std::isfinite(seconds) || seconds < 0.0)
-    throw DeviceFault(fmt::format("robot: hold for {} s (a wait, at least 0)", seconds));
-  SimWorld& world = *state_.world;
-  const double dt = world.substep();
-  const double held = std::min(seconds, Seconds(timeout));
-  for (int k = static_cast<int>(std::ceil(held / dt - 1e-9)); k > 0; --k) {
-    world.Step();
-    state_.TickSlip(dt);
-    state_.TickRobotAlarm(dt);
-  }
-  if (seconds > Seconds(timeout))
-    throw DeviceTimeout(
-        fmt::format("robot: a hold of {:.2f} s exceeds the timeout of {:.3f} s", seconds, Seconds(timeout)));
+  for (int k = static_cast<int>(std::ceil(seconds / state_.world->substep() - 1e-9)); k > 0; --k) Tick();
 }
 
 void SimRobot::ServoOn(Timeout /*timeout*/) {

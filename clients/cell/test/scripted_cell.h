@@ -111,11 +111,6 @@ class ScriptedRobot final : public devices::Robot {
     std::size_t after_moves = 0;
   };
   std::vector<HoldCall> holds;
-  void Hold(double seconds, devices::Timeout) override {
-    if (forbid_motion) ADD_FAILURE() << "Robot::Hold called";
-    if (fail_always) failure.Throw();
-    holds.push_back({X_BinTcp, seconds, moves.size()});
-  }
   Eigen::Isometry3d CurrentPose(devices::Timeout) override { return X_BinTcp; }
   void ServoOn(devices::Timeout) override {
     if (forbid_motion) ADD_FAILURE() << "Robot::ServoOn called";
@@ -127,6 +122,13 @@ class ScriptedRobot final : public devices::Robot {
     for (const Move& m : moves)
       if (m.X_BinTcpTarget.isApprox(X_BinTcpVisited, 1e-9)) return true;
     return false;
+  }
+
+ protected:
+  void HoldFor(double seconds) override {
+    if (forbid_motion) ADD_FAILURE() << "Robot::Hold called";
+    if (fail_always) failure.Throw();
+    holds.push_back({X_BinTcp, seconds, moves.size()});
   }
 };
 
