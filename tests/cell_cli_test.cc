@@ -41,6 +41,10 @@ TEST(CellCliTest, OneRoundWithAnAutoStartedServerPrintsTheTables) {
   EXPECT_EQ(j["statistics"]["bins_emptied"], 1);
   EXPECT_EQ(j["statistics"]["picks"], 2);
   EXPECT_EQ(j["rounds"][0]["tubes_left"], 0);
+  // The simulated bin held --tubes: both placed, none unaccounted for.
+  EXPECT_EQ(j["rounds"][0]["tubes_expected"], 2);
+  EXPECT_EQ(j["rounds"][0]["tubes_unaccounted"], 0);
+  EXPECT_EQ(j["statistics"]["tubes_unaccounted"], 0);
   const std::string records = testing::ReadText(records_path);
   EXPECT_NE(records.find("\"result\":\"picked\""), std::string::npos);
   EXPECT_NE(records.find("\"type\":\"end\""), std::string::npos);
@@ -276,6 +280,17 @@ TEST(CellCliTest, ControllerFileWithAnUnknownKeyExits2NamingTheKeyPath) {
   const testing::CliRun zero = RunCli("cell --sim --rounds 1 --controller " + path.string());
   EXPECT_EQ(zero.exit_code, 2) << zero.output;
   EXPECT_NE(zero.output.find("robot_timeout: must be positive"), std::string::npos) << zero.output;
+}
+
+TEST(CellCliTest, ATubeCountOtherThanTheSimulatedBinsExits2WithBoth) {
+  const auto dir = testing::TempDir("cell_controller_count");
+  const auto path = dir / "controller.yaml";
+  WriteText(path, "tubes_per_bin: 14\n");
+  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 7 --controller " + path.string());
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("tubes_per_bin: 14 in the controller config, but --tubes 7"), std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("started tubepick-server"), std::string::npos) << run.output;
 }
 
 TEST(CellCliTest, CellFileWithAnUnknownKeyExits2NamingTheKeyPath) {

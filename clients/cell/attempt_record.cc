@@ -169,6 +169,8 @@ nlohmann::json EndRecord(std::uint32_t round, const CellRunResult& result, const
           {"scans", result.scans},
           {"nudges", result.nudges},
           {"lost", result.lost},
+          {"tubes_expected", result.tubes_expected},
+          {"tubes_unaccounted", result.tubes_unaccounted},
           {"truth_start", truth_start},
           {"truth", truth}};
 }

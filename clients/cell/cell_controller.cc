@@ -124,8 +124,23 @@ std::string DescribeVanishedOverWalls(const CellRunResult& result) {
                      n == 1 ? "it may" : "they may", fmt::join(result.vanished_over_walls, "; "));
 }
 
+std::string DescribeTubeCount(const CellRunResult& result) {
+  if (result.tubes_expected == 0) return "";
+  if (result.tubes_unaccounted > 0)
+    return fmt::format(
+        "; {} of the bin's {} tubes unaccounted for (tubes_per_bin): not placed and not seen in the bin, {} "
+        "have fallen out of it or been carried out with another (check the floor around the bin)",
+        result.tubes_unaccounted, result.tubes_expected,
+        result.tubes_unaccounted == 1 ? "it may" : "they may");
+  if (result.picks > result.tubes_expected)
+    return fmt::format("; {} tubes placed from a bin of {} (tubes_per_bin): the count is wrong", result.picks,
+                       result.tubes_expected);
+  return "";
+}
+
 std::string DescribeRoundWarnings(const CellRunResult& result) {
-  return DescribePlannerWarnings(result) + DescribeTubeMassDoubt(result) + DescribeVanishedOverWalls(result);
+  return DescribePlannerWarnings(result) + DescribeTubeMassDoubt(result) + DescribeVanishedOverWalls(result) +
+         DescribeTubeCount(result);
 }
 
 std::string ToString(CellStopReason reason) {
@@ -268,10 +283,25 @@ bool CellController::ScanAndPick(RunState& run) {
     result.reason = CellStopReason::kBinEmpty;
     result.message = fmt::format("bin empty: {} picked in {} ({})", Count(result.picks, "tube"),
                                  Count(result.attempts, "attempt"), Count(result.scans, "scan"));
+    CountTubes(result);
     return false;
   }
   if (TryPlans(scan, run) == 0) NoExecutablePlan(scan, run);
   return true;
+}
+
+void CellController::CountTubes(CellRunResult& result) const {
+  if (params_.tubes_per_bin == 0) return;
+  result.tubes_expected = params_.tubes_per_bin;
+  result.tubes_unaccounted = result.picks < result.tubes_expected ? result.tubes_expected - result.picks : 0;
+  if (result.tubes_unaccounted > 0)
+    spdlog::warn(
+        "cell: round {}: the bin looks empty after {} of its {} tubes (tubes_per_bin) were placed: {} "
+        "unaccounted for, check the floor around the bin",
+        round_, result.picks, result.tubes_expected, result.tubes_unaccounted);
+  else if (result.picks > result.tubes_expected)
+    spdlog::warn("cell: round {}: {} tubes placed from a bin of {} (tubes_per_bin): the count is wrong",
+                 round_, result.picks, result.tubes_expected);
 }
 
 // ---------------------------------------------------------------- scan, plan

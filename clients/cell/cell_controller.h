@@ -119,6 +119,11 @@ struct CellRunResult {
   /// Tubes seen hanging over a wall that a later scan no longer showed though no attempt took them
   /// (VanishedOverWalls): they may have fallen out of the bin. Describe(TubeOverWall) each.
   std::vector<std::string> vanished_over_walls;
+  /// The bin found empty (kBinEmpty) and CellControllerParams::tubes_per_bin known: that count, and
+  /// how many of its tubes were not placed (tubes_per_bin − picks; 0 when picks reach it). 0 / 0
+  /// otherwise.
+  std::uint32_t tubes_expected = 0;
+  std::uint32_t tubes_unaccounted = 0;
 };
 
 /// "; the planner warned: tube_length_shorter_than_scan in 8 of 8 scans (check the cell)" for the
@@ -132,7 +137,11 @@ std::string DescribeTubeMassDoubt(const CellRunResult& result);
 /// -y wall at ... m, not seen again after scan 5", or "".
 std::string DescribeVanishedOverWalls(const CellRunResult& result);
 
-/// Both of the above, as the round's line ends.
+/// "; 1 of the bin's 20 tubes unaccounted for (tubes_per_bin): ...", "; 21 tubes placed from a bin
+/// of 20 (tubes_per_bin): ...", or "" (the count not known, met, or the bin not found empty).
+std::string DescribeTubeCount(const CellRunResult& result);
+
+/// All of the above, as the round's line ends.
 std::string DescribeRoundWarnings(const CellRunResult& result);
 
 /// What a command of a run does (PlannedMotion).
@@ -342,6 +351,9 @@ class CellController {
   /// attempt or nudge took them (nor a lift of several tubes): logged, recorded with the next
   /// record and on the round's result.
   void WatchWalls(PlannedScan& scan, const devices::Capture& capture, RunState& run);
+  /// The bin found empty: sets result.tubes_expected and tubes_unaccounted from tubes_per_bin (if
+  /// known) and warns when the picks fall short of it or pass it.
+  void CountTubes(CellRunResult& result) const;
   /// Moves the scan's vanished_over_walls into `record` (the first record of the scan).
   static void TakeVanishedOverWalls(PlannedScan& scan, nlohmann::json& record);
   /// The scan's plans in rank order, skipping those that cannot be executed; returns how many ran.

@@ -199,6 +199,8 @@ void DescribeFields(Visit& v, CellControllerParams& p) {
   v.Section("wall_watch", p.wall_watch,
             "a tube a scan shows hanging over a wall that the next scan does not show, though no\n"
             "attempt took it, may have fallen out of the bin: logged, recorded, on the round's line");
+  v("tubes_per_bin", p.tubes_per_bin,
+    "tubes in a full bin, 0 = not known: a bin that looks empty with fewer placed says so");
   DescribePlannerFields(v, p);
   DescribeLimitFields(v, p);
 }

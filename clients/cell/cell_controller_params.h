@@ -183,6 +183,13 @@ struct CellControllerParams {
   /// several lifted).
   std::uint32_t max_consecutive_failures = 6;
 
+  // --- the bin ---
+  /// Tubes a bin holds when its round starts; 0 = not known. When known, a round that finds the bin
+  /// empty with fewer tubes placed says how many are unaccounted for (CellRunResult::
+  /// tubes_unaccounted): a tube that left the bin where no scan of it sees is otherwise a silent
+  /// "bin empty". In the simulated cell, `--tubes`.
+  std::uint32_t tubes_per_bin = 0;
+
   // --- timeouts ---
   devices::Timeout scanner_timeout{30'000};
   /// One robot motion (the longest: a lift of ~0.4 m at lift_speed, or a transit).

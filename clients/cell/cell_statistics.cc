@@ -77,6 +77,7 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
             truth ? r["truth"]["tubes_in_bin"].get<std::uint32_t>() == 0 : reason == "bin_empty";
         if (emptied) ++s.bins_emptied;
         if (truth && reason == "bin_empty" && !emptied) ++s.false_empty;
+        s.tubes_unaccounted += r.value("tubes_unaccounted", 0u);
         if (reason == "limit_reached") ++s.limit_stops;
         if (reason == "fault") ++s.fault_stops;
         if (reason == "stopped") ++s.operator_stops;
@@ -187,6 +188,7 @@ json StatisticsJson(const CellStatistics& s) {
   return {{"rounds", s.rounds},
           {"bins_emptied", s.bins_emptied},
           {"false_empty", s.false_empty},
+          {"tubes_unaccounted", s.tubes_unaccounted},
           {"limit_stops", s.limit_stops},
           {"fault_stops", s.fault_stops},
           {"operator_stops", s.operator_stops},

@@ -71,6 +71,7 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.analyze_deadline, b.analyze_deadline);
   EXPECT_EQ(a.max_attempts_per_tube, b.max_attempts_per_tube);
   EXPECT_EQ(a.max_attempts_per_bin, b.max_attempts_per_bin);
+  EXPECT_EQ(a.tubes_per_bin, b.tubes_per_bin);
   EXPECT_EQ(a.max_consecutive_failures, b.max_consecutive_failures);
   EXPECT_EQ(a.scanner_timeout, b.scanner_timeout);
   EXPECT_EQ(a.robot_timeout, b.robot_timeout);
@@ -134,6 +135,7 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.resolution_hold_over_bin = false;
   p.resolution_wall_margin = 0.09;
   p.resolution_dwell = 0.25;
+  p.tubes_per_bin = 20;
   p.approach_height = 0.13;
   p.transit_clearance = 0.31;
   p.place_approach_height = 0.14;

@@ -140,6 +140,60 @@ TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
   EXPECT_EQ(planner.plan_requests[0].options().seed(), params.seed);
 }
 
+TEST_F(CellControllerTest, ABinThatLooksEmptyShortOfItsTubesSaysHowManyAreUnaccountedFor) {
+  // One tube placed, then the planner sees the bin empty: with tubes_per_bin = 3, two are missing.
+  params.tubes_per_bin = 3;
+  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
+  ft.readings = {Reading(0.10), Reading(0.64)};
+  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  const CellRunResult result = Run();
+  ASSERT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
+  EXPECT_EQ(result.picks, 1u);
+  EXPECT_EQ(result.tubes_expected, 3u);
+  EXPECT_EQ(result.tubes_unaccounted, 2u);
+  EXPECT_THAT(DescribeRoundWarnings(result),
+              ::testing::HasSubstr(
+                  "; 2 of the bin's 3 tubes unaccounted for (tubes_per_bin): not placed and not seen in "
+                  "the bin, they may have fallen out of it"));
+  const std::vector<json> end = Records("end");
+  ASSERT_EQ(end.size(), 1u);
+  EXPECT_EQ(end[0]["tubes_expected"], 3);
+  EXPECT_EQ(end[0]["tubes_unaccounted"], 2);
+}
+
+TEST_F(CellControllerTest, TheTubeCountIsQuietWhenMetOrNotKnownAndOnlyForABinFoundEmpty) {
+  const auto run_one_pick = [&](std::uint32_t tubes_per_bin) {
+    params.tubes_per_bin = tubes_per_bin;
+    planner.plan_answers = {Plans({MakePlan(4, p_Bin_grasp)}, 1)};
+    ft.readings = {Reading(0.10), Reading(0.64)};
+    planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+    return Run();
+  };
+  const CellRunResult met = run_one_pick(1);
+  EXPECT_EQ(met.picks, 1u);
+  EXPECT_EQ(met.tubes_expected, 1u);
+  EXPECT_EQ(met.tubes_unaccounted, 0u);
+  EXPECT_EQ(DescribeTubeCount(met), "");
+  const CellRunResult unknown = run_one_pick(0);
+  EXPECT_EQ(unknown.tubes_expected, 0u);
+  EXPECT_EQ(unknown.tubes_unaccounted, 0u);
+  // A round stopped at a limit leaves tubes in the bin on purpose: nothing is counted.
+  params.tubes_per_bin = 5;
+  params.max_attempts_per_bin = 1;
+  planner.plan_answers = {Plans({MakePlan(1, p_Bin_grasp)}, 2), Plans({MakePlan(1, GraspSpot(3))}, 2)};
+  gripper.close_results = {ClosedOnNothing()};
+  const CellRunResult limited = Run();
+  ASSERT_EQ(limited.reason, CellStopReason::kLimitReached) << limited.message;
+  EXPECT_EQ(limited.tubes_expected, 0u);
+  EXPECT_EQ(limited.tubes_unaccounted, 0u);
+  // More placed than the count: the count is wrong (said, nothing unaccounted).
+  CellRunResult over;
+  over.picks = 21;
+  over.tubes_expected = 20;
+  EXPECT_EQ(DescribeTubeCount(over),
+            "; 21 tubes placed from a bin of 20 (tubes_per_bin): the count is wrong");
+}
+
 TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   ft.readings = {Reading(0.10), Reading(0.64)};

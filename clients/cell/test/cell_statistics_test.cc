@@ -118,6 +118,16 @@ TEST(CellStatisticsTest, WithoutTruthTheplannersCountAndBinEmptyDecide) {
   EXPECT_EQ(s.tubes_total, 0u);
 }
 
+TEST(CellStatisticsTest, TubesUnaccountedForAreSummedOverTheRounds) {
+  json first = End(0, "bin_empty", 20, 0);
+  first["tubes_unaccounted"] = 2;
+  json second = End(1, "bin_empty", 20, 0);
+  second["tubes_unaccounted"] = 1;
+  const CellStatistics s = SummarizeRecords({first, second, End(2, "bin_empty", 20, 0)});
+  EXPECT_EQ(s.tubes_unaccounted, 3u);
+  EXPECT_EQ(StatisticsJson(s)["tubes_unaccounted"], 3);
+}
+
 TEST(CellStatisticsTest, MedianOfEvenAndOddLists) {
   EXPECT_DOUBLE_EQ(Median({3.0, 1.0, 2.0}), 2.0);
   EXPECT_DOUBLE_EQ(Median({4.0, 1.0, 3.0, 2.0}), 2.5);

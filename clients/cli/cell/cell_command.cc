@@ -74,6 +74,7 @@ struct CellOptions {
   bool profile_given = false;
   bool resolution_given = false;
   bool plan_deadline_given = false;
+  bool tubes_given = false;
 };
 
 v1::ResolutionVariant ParseVariant(const std::string& name) {
@@ -97,6 +98,14 @@ cell::CellControllerParams ControllerParams(const CellOptions& o) {
     params.plan_deadline = std::chrono::milliseconds(std::llround(o.plan_deadline * 1000.0));
   }
   if (o.max_attempts_per_tube > 0) params.max_attempts_per_tube = o.max_attempts_per_tube;
+  if (o.sim || o.tubes_given) {  // the simulated bins hold --tubes; a real cell's, if given
+    if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
+    if (params.tubes_per_bin != 0 && params.tubes_per_bin != o.tubes)
+      throw InvalidArgument(fmt::format(
+          "tubes_per_bin: {} in the controller config, but --tubes {} (leave it 0 or give the same)",
+          params.tubes_per_bin, o.tubes));
+    params.tubes_per_bin = o.tubes;
+  }
   params.Validate();
   return params;
 }
@@ -184,6 +193,8 @@ json RoundJson(std::uint32_t round, const cell::CellRunResult& result, double wa
           {"planner_warnings", result.planner_warnings},
           {"tube_mass_doubts", result.tube_mass_doubts},
           {"tube_mass_doubt", result.tube_mass_doubt},
+          {"tubes_expected", result.tubes_expected},
+          {"tubes_unaccounted", result.tubes_unaccounted},
           {"wall_s", wall}};
 }
 
@@ -415,7 +426,11 @@ void AddCellCommand(CLI::App& app) {
                   "Name to check the planner's certificate against (default: the address' host)");
   cmd->add_option("--rounds", o->rounds, "Rounds (bins) to run; round r uses seed + r")
       ->capture_default_str();
-  cmd->add_option("--tubes", o->tubes, "Tubes dropped into the bin per round")->capture_default_str();
+  CLI::Option* tubes =
+      cmd->add_option("--tubes", o->tubes,
+                      "Tubes per bin: dropped into each simulated bin; with --devices, how many "
+                      "each bin holds (the controller's tubes_per_bin)")
+          ->capture_default_str();
   cmd->add_option("--material", o->material, "pvc (set A) or rubber (set B), thesis Table 5.2")
       ->capture_default_str();
   cmd->add_option(
@@ -485,10 +500,11 @@ void AddCellCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--fault-seed", o->fault_seed, "Seed of the injected faults (round r: seed·1000 + r)")
       ->capture_default_str();
-  cmd->callback([o, profile, resolution, plan_deadline] {
+  cmd->callback([o, profile, resolution, plan_deadline, tubes] {
     o->profile_given = profile->count() > 0;
     o->resolution_given = resolution->count() > 0;
     o->plan_deadline_given = plan_deadline->count() > 0;
+    o->tubes_given = tubes->count() > 0;
     Run(*o);
   });
 }

@@ -49,6 +49,7 @@ std::string FormatCellTables(const CellStatistics& s, const std::string& title) 
   out += fmt::format("  {:<34}{:>7} limit, {} fault, {} operator\n", "rounds stopped early", s.limit_stops,
                      s.fault_stops, s.operator_stops);
   out += fmt::format("  {:<34}{:>7}\n", "bin reported empty, tubes left", s.false_empty);
+  out += fmt::format("  {:<34}{:>7}\n", "bin empty, tubes unaccounted for", s.tubes_unaccounted);
   out += fmt::format("  {:<34}{:>7}\n", "tubes carried along or dropped out", s.tubes_lost);
   out += fmt::format("  {:<34}{:>7}\n", "tubes seen slipping out (lost)", s.lost_in_transit);
   out += "\n";
