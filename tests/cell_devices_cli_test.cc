@@ -132,9 +132,13 @@ TEST(VirtualCellTest, CheckThenOneRoundThroughTheRealDriversEmptiesTheBin) {
 
   const auto json_path = dir / "round.json";
   const auto records_path = dir / "records.jsonl";
-  const testing::CliRun run = RunCli("cell --devices " + cell.devices.string() + " --rounds 1 --json " +
-                                     json_path.string() + " --records " + records_path.string());
+  // Told the bin held 5 where the virtual cell dropped 4: the bin found empty says one is missing.
+  const testing::CliRun run =
+      RunCli("cell --devices " + cell.devices.string() + " --rounds 1 --tubes 5 --json " +
+             json_path.string() + " --records " + records_path.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("; 1 of the bin's 5 tubes unaccounted for (tubes_per_bin)"), std::string::npos)
+      << run.output;
   EXPECT_NE(run.output.find(
                 "devices: robot yaskawa-hses, gripper robotiq-2f85-rtu, F/T ati-netft-rdt, scanner exec"),
             std::string::npos)
@@ -142,6 +146,8 @@ TEST(VirtualCellTest, CheckThenOneRoundThroughTheRealDriversEmptiesTheBin) {
   const nlohmann::json j = testing::ReadJson(json_path);
   EXPECT_EQ(j["statistics"]["picks"], 4) << j.dump(2);
   EXPECT_EQ(j["rounds"][0]["reason"], "bin_empty");
+  EXPECT_EQ(j["rounds"][0]["tubes_unaccounted"], 1);
+  EXPECT_EQ(j["statistics"]["tubes_unaccounted"], 1);
   EXPECT_NE(testing::ReadText(records_path).find("\"type\":\"end\""), std::string::npos);
 
   EXPECT_EQ(cell.Stop(), "virtual-cell: tubes_in_bin=0 placed=4 outside=0") << cell.cli.Output();
