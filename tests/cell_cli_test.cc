@@ -280,17 +280,13 @@ TEST(CellCliTest, ControllerFileWithAnUnknownKeyExits2NamingTheKeyPath) {
   const testing::CliRun zero = RunCli("cell --sim --rounds 1 --controller " + path.string());
   EXPECT_EQ(zero.exit_code, 2) << zero.output;
   EXPECT_NE(zero.output.find("robot_timeout: must be positive"), std::string::npos) << zero.output;
-}
 
-TEST(CellCliTest, ATubeCountOtherThanTheSimulatedBinsExits2WithBoth) {
-  const auto dir = testing::TempDir("cell_controller_count");
-  const auto path = dir / "controller.yaml";
+  // A tube count other than the simulated bins': both named.
   WriteText(path, "tubes_per_bin: 14\n");
-  const testing::CliRun run = RunCli("cell --sim --rounds 1 --tubes 7 --controller " + path.string());
-  EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_NE(run.output.find("tubes_per_bin: 14 in the controller config, but --tubes 7"), std::string::npos)
-      << run.output;
-  EXPECT_EQ(run.output.find("started tubepick-server"), std::string::npos) << run.output;
+  const testing::CliRun count = RunCli("cell --sim --rounds 1 --tubes 7 --controller " + path.string());
+  EXPECT_EQ(count.exit_code, 2) << count.output;
+  EXPECT_NE(count.output.find("tubes_per_bin: 14 in the controller config, but --tubes 7"), std::string::npos)
+      << count.output;
 }
 
 TEST(CellCliTest, CellFileWithAnUnknownKeyExits2NamingTheKeyPath) {

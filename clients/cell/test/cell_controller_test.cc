@@ -106,6 +106,12 @@ class CellControllerTest : public ::testing::Test {
   Eigen::Vector3d GraspSpot(int i) const {
     return p_Bin_grasp + Eigen::Vector3d(-0.04 * (i % 5), 0.04 * (i / 5), 0.0);
   }
+  /// Scan 1 plans one tube, lifted alone and placed; scan 2 sees the bin empty.
+  void ScriptOneSinglePick() {
+    planner.plan_answers = {Plans({MakePlan(4, p_Bin_grasp)}, 1)};
+    ft.readings = {Reading(0.10), Reading(0.64)};
+    planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  }
   /// Scan 1 plans grasp A, which closes on nothing; scan 2 plans A again first, then B elsewhere.
   void ScriptGraspFailedThenSameGrasp() {
     params.max_plans_per_scan = 1;
@@ -143,9 +149,7 @@ TEST_F(CellControllerTest, EmptyBinAtFirstScanFinishesWithoutAttempts) {
 TEST_F(CellControllerTest, ABinThatLooksEmptyShortOfItsTubesSaysHowManyAreUnaccountedFor) {
   // One tube placed, then the planner sees the bin empty: with tubes_per_bin = 3, two are missing.
   params.tubes_per_bin = 3;
-  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
-  ft.readings = {Reading(0.10), Reading(0.64)};
-  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  ScriptOneSinglePick();
   const CellRunResult result = Run();
   ASSERT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
   EXPECT_EQ(result.picks, 1u);
@@ -164,9 +168,7 @@ TEST_F(CellControllerTest, ABinThatLooksEmptyShortOfItsTubesSaysHowManyAreUnacco
 TEST_F(CellControllerTest, TheTubeCountIsQuietWhenMetOrNotKnownAndOnlyForABinFoundEmpty) {
   const auto run_one_pick = [&](std::uint32_t tubes_per_bin) {
     params.tubes_per_bin = tubes_per_bin;
-    planner.plan_answers = {Plans({MakePlan(4, p_Bin_grasp)}, 1)};
-    ft.readings = {Reading(0.10), Reading(0.64)};
-    planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+    ScriptOneSinglePick();
     return Run();
   };
   const CellRunResult met = run_one_pick(1);
@@ -195,9 +197,7 @@ TEST_F(CellControllerTest, TheTubeCountIsQuietWhenMetOrNotKnownAndOnlyForABinFou
 }
 
 TEST_F(CellControllerTest, SinglePickIsPlacedAndRecorded) {
-  planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
-  ft.readings = {Reading(0.10), Reading(0.64)};
-  planner.wrench_answers.push_back(Outcome(v1::HELD_OUTCOME_SINGLE, 1.0));
+  ScriptOneSinglePick();
 
   const CellRunResult result = Run();
   EXPECT_EQ(result.reason, CellStopReason::kBinEmpty) << result.message;
