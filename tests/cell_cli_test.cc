@@ -45,6 +45,9 @@ TEST(CellCliTest, OneRoundWithAnAutoStartedServerPrintsTheTables) {
   EXPECT_EQ(j["rounds"][0]["tubes_expected"], 2);
   EXPECT_EQ(j["rounds"][0]["tubes_unaccounted"], 0);
   EXPECT_EQ(j["statistics"]["tubes_unaccounted"], 0);
+  EXPECT_NE(run.output.find("bin empty, tubes unaccounted for        0 (1 of 1 rounds counted)"),
+            std::string::npos)
+      << run.output;
   const std::string records = testing::ReadText(records_path);
   EXPECT_NE(records.find("\"result\":\"picked\""), std::string::npos);
   EXPECT_NE(records.find("\"type\":\"end\""), std::string::npos);

@@ -78,6 +78,7 @@ CellStatistics SummarizeRecords(const std::vector<json>& records) {
         if (emptied) ++s.bins_emptied;
         if (truth && reason == "bin_empty" && !emptied) ++s.false_empty;
         s.tubes_unaccounted += r.value("tubes_unaccounted", 0u);
+        if (r.value("tubes_expected", 0u) > 0) ++s.counted_rounds;
         if (reason == "limit_reached") ++s.limit_stops;
         if (reason == "fault") ++s.fault_stops;
         if (reason == "stopped") ++s.operator_stops;
@@ -189,6 +190,7 @@ json StatisticsJson(const CellStatistics& s) {
           {"bins_emptied", s.bins_emptied},
           {"false_empty", s.false_empty},
           {"tubes_unaccounted", s.tubes_unaccounted},
+          {"counted_rounds", s.counted_rounds},
           {"limit_stops", s.limit_stops},
           {"fault_stops", s.fault_stops},
           {"operator_stops", s.operator_stops},

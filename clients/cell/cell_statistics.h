@@ -53,8 +53,10 @@ struct CellStatistics {
   /// Rounds the planner declared empty while tubes were still in the bin (ground truth).
   std::uint32_t false_empty = 0;
   /// Tubes the controller found unaccounted for when a bin looked empty (CellRunResult::
-  /// tubes_unaccounted: tubes_per_bin known, fewer placed; no ground truth needed).
+  /// tubes_unaccounted: tubes_per_bin known, fewer placed; no ground truth needed), and the rounds
+  /// whose count was known (tubes_expected > 0): with none, the 0 says nothing.
   std::uint32_t tubes_unaccounted = 0;
+  std::uint32_t counted_rounds = 0;
   std::uint32_t limit_stops = 0;
   std::uint32_t fault_stops = 0;
   /// Rounds the operator stopped (CellController::RequestStop).

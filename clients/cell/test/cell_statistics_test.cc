@@ -123,9 +123,13 @@ TEST(CellStatisticsTest, TubesUnaccountedForAreSummedOverTheRounds) {
   first["tubes_unaccounted"] = 2;
   json second = End(1, "bin_empty", 20, 0);
   second["tubes_unaccounted"] = 1;
-  const CellStatistics s = SummarizeRecords({first, second, End(2, "bin_empty", 20, 0)});
+  json third = End(2, "bin_empty", 20, 0);
+  for (json* end : {&first, &second}) (*end)["tubes_expected"] = 20;
+  const CellStatistics s = SummarizeRecords({first, second, third});
   EXPECT_EQ(s.tubes_unaccounted, 3u);
+  EXPECT_EQ(s.counted_rounds, 2u);  // the third round's count was not known
   EXPECT_EQ(StatisticsJson(s)["tubes_unaccounted"], 3);
+  EXPECT_EQ(StatisticsJson(s)["counted_rounds"], 2);
 }
 
 TEST(CellStatisticsTest, MedianOfEvenAndOddLists) {

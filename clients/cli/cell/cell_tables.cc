@@ -49,7 +49,11 @@ std::string FormatCellTables(const CellStatistics& s, const std::string& title) 
   out += fmt::format("  {:<34}{:>7} limit, {} fault, {} operator\n", "rounds stopped early", s.limit_stops,
                      s.fault_stops, s.operator_stops);
   out += fmt::format("  {:<34}{:>7}\n", "bin reported empty, tubes left", s.false_empty);
-  out += fmt::format("  {:<34}{:>7}\n", "bin empty, tubes unaccounted for", s.tubes_unaccounted);
+  out +=
+      s.counted_rounds > 0
+          ? fmt::format("  {:<34}{:>7} ({} of {} rounds counted)\n", "bin empty, tubes unaccounted for",
+                        s.tubes_unaccounted, s.counted_rounds, s.rounds)
+          : fmt::format("  {:<34}{:>7} (tubes_per_bin not known)\n", "bin empty, tubes unaccounted for", "-");
   out += fmt::format("  {:<34}{:>7}\n", "tubes carried along or dropped out", s.tubes_lost);
   out += fmt::format("  {:<34}{:>7}\n", "tubes seen slipping out (lost)", s.lost_in_transit);
   out += "\n";

@@ -48,6 +48,17 @@ TEST(CellTables, ColumnsAreTubeCountsLargestFirstThenOverall) {
   EXPECT_THAT(text, HasSubstr("  planning (PlanPick, wall)             0.30s    0.30s"));
 }
 
+TEST(CellTables, TubesUnaccountedForSayWhetherAnyRoundKnewItsCount) {
+  cell::CellStatistics s = TwoCounts();
+  s.tubes_unaccounted = 3;
+  s.counted_rounds = 4;
+  EXPECT_THAT(FormatCellTables(s, "counted"),
+              HasSubstr("  bin empty, tubes unaccounted for        3 (4 of 4 rounds counted)"));
+  // No round knew tubes_per_bin: a dash, not a reassuring 0.
+  EXPECT_THAT(FormatCellTables(TwoCounts(), "not counted"),
+              HasSubstr("  bin empty, tubes unaccounted for        - (tubes_per_bin not known)"));
+}
+
 TEST(CellTables, AnUnusedRowShowsADashNotAZeroRate) {
   const std::string text = FormatCellTables(cell::CellStatistics{}, "empty");
   EXPECT_THAT(text, HasSubstr("bins emptied                            0/0 (-)"));
