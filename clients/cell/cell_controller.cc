@@ -294,14 +294,9 @@ void CellController::CountTubes(CellRunResult& result) const {
   if (params_.tubes_per_bin == 0) return;
   result.tubes_expected = params_.tubes_per_bin;
   result.tubes_unaccounted = result.picks < result.tubes_expected ? result.tubes_expected - result.picks : 0;
-  if (result.tubes_unaccounted > 0)
-    spdlog::warn(
-        "cell: round {}: the bin looks empty after {} of its {} tubes (tubes_per_bin) were placed: {} "
-        "unaccounted for, check the floor around the bin",
-        round_, result.picks, result.tubes_expected, result.tubes_unaccounted);
-  else if (result.picks > result.tubes_expected)
-    spdlog::warn("cell: round {}: {} tubes placed from a bin of {} (tubes_per_bin): the count is wrong",
-                 round_, result.picks, result.tubes_expected);
+  // The round line's words ("; 2 of the bin's 20 tubes ...", or "" when the count is met).
+  const std::string said = DescribeTubeCount(result);
+  if (!said.empty()) spdlog::warn("cell: round {}: bin empty: {}", round_, said.substr(2));
 }
 
 // ---------------------------------------------------------------- scan, plan

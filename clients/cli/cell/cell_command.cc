@@ -302,7 +302,6 @@ void Run(const CellOptions& o) {
   const bool custom_cell = !o.cell_path.empty();  // --devices: OpenCell reads it
   const CellConfig cell_config = custom_cell ? LoadCellConfig(o.cell_path) : CellConfig{};
   if (o.rounds == 0) throw InvalidArgument("--rounds: must be at least 1");
-  if (o.tubes == 0) throw InvalidArgument("--tubes: must be at least 1");
   const devices::sim::Material material = devices::sim::ParseMaterial(o.material, "--material");
 
   if (!(o.fault_rate >= 0.0 && o.fault_rate <= 1.0))
