@@ -69,8 +69,9 @@ ModelingParams FastModelingProfile() {
   // segment, so its tree came out split (report.json: a tree with 9 % or more of its points in no
   // model was correct 2 times in 10). On 20 bins per point (`tubepick eval --generate N --preset P
   // --per-count 20`, docs/ACCURACY.md): 10 set-C trees 74.0 -> 93.0 % correct, 20 set-A tubes
-  // 88.2 -> 99.2 %, 20 set-B tubes 83.0 -> 98.2 %, 10 linear tubes unchanged; modeling about 1.6x
-  // slower (docs/PERFORMANCE.md). 150 000 points gained nothing more.
+  // 88.2 -> 99.2 %, 20 set-B tubes 83.0 -> 98.2 %, 10 linear tubes unchanged. The price: the
+  // modeling stages about 2.5x slower, a plan through the server about 2x (docs/PERFORMANCE.md,
+  // "The point budget"). 150 000 points gained nothing more.
   RandomSampleParams sample;
   sample.count = 100000;
   RadiusOutlierParams radius;
