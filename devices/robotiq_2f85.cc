@@ -130,9 +130,11 @@ Robotiq2F85::~Robotiq2F85() {
 
 namespace {
 
-// An unanswered request (or one answered with a bad CRC: a noisy RS-485 line) is sent again while the
-// call's deadline leaves time for a whole response_timeout; both requests are idempotent (a status
-// read, the action request registers written again). Throws when out of time.
+// An unanswered request, one answered with a bad CRC (a noisy RS-485 line) or with an answer that
+// does not fit it (EMBBADDATA: a late answer to an earlier request that timed out, arriving after
+// the flush) is sent again while the call's deadline leaves time for a whole response_timeout; both
+// requests are idempotent (a status read, the action request registers written again). Throws when
+// out of time.
 template <typename Request>
 void WithRetries(Request&& request, std::chrono::steady_clock::time_point deadline,
                  std::chrono::milliseconds response_timeout, const std::string& what,
@@ -140,7 +142,7 @@ void WithRetries(Request&& request, std::chrono::steady_clock::time_point deadli
   for (int tries = 1;; ++tries) {
     const int err = request();
     if (err == 0) return;
-    const bool retriable = err == ETIMEDOUT || err == EMBBADCRC;
+    const bool retriable = err == ETIMEDOUT || err == EMBBADCRC || err == EMBBADDATA;
     if (retriable && std::chrono::steady_clock::now() + response_timeout <= deadline) continue;
     const std::string count = std::to_string(tries) + (tries == 1 ? " try" : " tries");
     if (err == ETIMEDOUT)

@@ -169,6 +169,28 @@ TEST(Robotiq2F85, ALostRequestIsSentAgainWithinTheCallsTimeout) {
   }
 }
 
+TEST(Robotiq2F85, AnAnswerThatDoesNotFitTheRequestIsAskedAgain) {
+  // A late answer to an earlier, timed-out request arrives where the write's answer should: libmodbus
+  // calls it invalid data (EMBBADDATA). The write is sent again and the close completes; a gripper
+  // that answers every write so fails the call naming the error and the tries.
+  RobotiqFake fake;
+  fake.SetObjectWidth(0.016);
+  Robotiq2F85 gripper(ParamsFor(fake));
+  gripper.Activate(2s);
+  fake.AnswerNextWritesWithARead(1);
+  EXPECT_EQ(gripper.Close(0.15, 50.0, 5s).object, GripperObject::kStoppedClosing);
+  fake.AnswerNextWritesWithARead(1000000);  // more than fit in the call
+  try {
+    gripper.Open(350ms);
+    FAIL() << "expected DeviceFault";
+  } catch (const DeviceFault& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("request write failed on"), std::string::npos) << what;
+    EXPECT_NE(what.find("Invalid data"), std::string::npos) << what;
+    EXPECT_EQ(what.find("(1 try)"), std::string::npos) << what;
+  }
+}
+
 TEST(Robotiq2F85, ActivationThatNeverCompletesTimesOut) {
   RobotiqFake::Options o;
   o.activation_time = 10s;

@@ -85,6 +85,11 @@ void RobotiqFake::DropNext(int count) {
   drop_ = count;
 }
 
+void RobotiqFake::AnswerNextWritesWithARead(int count) {
+  std::lock_guard lock(mutex_);
+  writes_answered_with_a_read_ = count;
+}
+
 double RobotiqFake::position() const {
   std::lock_guard lock(mutex_);
   return pos_;
@@ -103,6 +108,12 @@ void RobotiqFake::Run() {
     if (mute_) continue;
     if (drop_ > 0) {
       --drop_;
+      continue;
+    }
+    if (req[1] == MODBUS_FC_WRITE_MULTIPLE_REGISTERS && writes_answered_with_a_read_ > 0) {
+      --writes_answered_with_a_read_;
+      req[1] = MODBUS_FC_READ_HOLDING_REGISTERS;  // same address and count fields: a read's reply
+      modbus_reply(ctx_, req, rc, map_);
       continue;
     }
     const int function = req[1];

@@ -42,6 +42,9 @@ class RobotiqFake {
   void SetMute(bool mute);
   /// Read and drop the next `count` requests (a noisy line losing frames), then answer again.
   void DropNext(int count);
+  /// Answer the next `count` register writes with a register read's response, not applying them:
+  /// what a late answer to an earlier request looks like to the driver.
+  void AnswerNextWritesWithARead(int count);
   /// Current simulated finger position (0 open .. 255 closed).
   double position() const;
   int requests_served() const { return served_.load(); }
@@ -63,6 +66,7 @@ class RobotiqFake {
   std::uint8_t fault_ = 0;
   bool mute_ = false;
   int drop_ = 0;
+  int writes_answered_with_a_read_ = 0;
   bool activated_ = false;
   bool activating_ = false;
   std::chrono::steady_clock::time_point activation_start_;
