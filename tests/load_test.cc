@@ -132,6 +132,38 @@ TEST(LoadAgainstServer, CountsOkAndInvalidArgumentRoundRobin) {
   EXPECT_NE(json.find("\"start_unix_seconds\""), std::string::npos) << json;
 }
 
+TEST(LoadAgainstServer, AFixedRateStartsCallsOnTheirSlots) {
+  // 4 calls a second for 1.5 s, each answered at once (INVALID_ARGUMENT): slots at 0, 0.25 .. 1.25 s,
+  // whatever the two threads could do in between.
+  LocalServer server(/*workers=*/2, /*queue=*/8);
+  LoadOptions o;
+  o.channel.target = server.target();
+  o.rpcs = {LoadRpc::kModelTubes};
+  o.concurrency = 2;
+  o.duration_seconds = 1.5;
+  o.rate = 4.0;
+  const LoadReport r = RunLoad(o, {BadCloud()});
+  EXPECT_EQ(r.total, 6u);
+  EXPECT_EQ(r.status_counts.at("INVALID_ARGUMENT"), 6u);
+  ASSERT_EQ(r.calls.size(), 6u);
+  for (std::size_t i = 1; i < r.calls.size(); ++i)
+    EXPECT_GT(r.calls[i].start_unix_seconds - r.calls[i - 1].start_unix_seconds, 0.15) << "call " << i;
+  EXPECT_GT(r.calls.back().start_unix_seconds - r.calls.front().start_unix_seconds, 1.2);
+  EXPECT_EQ(r.rate, 4.0);
+  EXPECT_GE(r.max_start_lag_seconds, 0.0);
+  EXPECT_NE(FormatLoadReportText(r).find("Rate:         4.000 calls/s asked"), std::string::npos);
+
+  // Two RPCs take the slots in turn: 3 calls each, whichever thread is free first.
+  o.rpcs = {LoadRpc::kModelTubes, LoadRpc::kPlanPick};
+  const LoadReport mix = RunLoad(o, {BadCloud()});
+  ASSERT_EQ(mix.by_rpc.size(), 2u);
+  EXPECT_EQ(mix.by_rpc[0].total, 3u);
+  EXPECT_EQ(mix.by_rpc[1].total, 3u);
+
+  o.rate = -1.0;
+  EXPECT_THROW(RunLoad(o, {BadCloud()}), InvalidArgument);
+}
+
 TEST(LoadAgainstServer, PlanPickStreamInSmallChunks) {
   LocalServer server(/*workers=*/1, /*queue=*/4);
   LoadOptions o;

@@ -110,6 +110,12 @@ void AddLoadCommand(CLI::App& app) {
                        ->check(CLI::PositiveNumber);
   total->excludes(duration);
   duration->excludes(total);
+  cmd->add_option(
+         "--rate", o->load.rate,
+         "Calls per second to start in the measured phase, open loop (0 = each thread calls again as soon "
+         "as its call ends); --concurrency caps the calls in flight")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--warmup", o->load.warmup, "Calls before measuring (not counted)")->capture_default_str();
   cmd->add_option("--deadline", o->load.deadline_seconds, "Deadline of each call, seconds (0 = none)")
       ->check(CLI::NonNegativeNumber)

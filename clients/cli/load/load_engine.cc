@@ -170,7 +170,29 @@ struct MeasuredPhase {
   Clock::time_point t0;
   std::optional<Clock::time_point> end;  ///< duration runs
   std::optional<RssSampler> sampler;     ///< started with the phase
+  /// Open loop (LoadOptions::rate): each RPC's next slot (RPC r of n takes the slots k·n + r, so the
+  /// mix stays fixed), and the most a call started after its slot.
+  explicit MeasuredPhase(std::size_t rpcs) : slots(rpcs) {}
+  std::vector<std::atomic<std::uint64_t>> slots;
+  std::mutex lag_mutex;
+  double max_start_lag_seconds = 0.0;
 };
+
+/// With a rate, waits for the next slot of RPC `rpc` (phase.t0 + k / rate, k = its j-th slot · the
+/// number of RPCs + rpc) and returns false when it lies at or after the phase's end; without a rate,
+/// returns true at once.
+bool WaitForSlot(const LoadOptions& o, MeasuredPhase& phase, std::size_t rpc) {
+  if (!(o.rate > 0.0)) return true;
+  const std::uint64_t k = phase.slots[rpc].fetch_add(1) * phase.slots.size() + rpc;
+  const Clock::time_point at =
+      phase.t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(k / o.rate));
+  if (phase.end && at >= *phase.end) return false;
+  std::this_thread::sleep_until(at);
+  const double lag = std::chrono::duration<double>(Clock::now() - at).count();
+  std::lock_guard lock(phase.lag_mutex);
+  phase.max_start_lag_seconds = std::max(phase.max_start_lag_seconds, lag);
+  return true;
+}
 
 /// Runs the calls: `concurrency` threads, each with one call in flight, until o.total measured calls
 /// started or the measured phase's end passed. calls[k][c] is cloud c prepared for o.rpcs[k]; thread w
@@ -207,6 +229,7 @@ std::vector<CallRecord> RunCalls(const Caller& caller, const std::vector<std::ve
         if (measured) {
           if (o.total > 0 && started.fetch_add(1) >= o.total) break;
           if (phase.end && Clock::now() >= *phase.end) break;
+          if (!WaitForSlot(o, phase, rpc)) break;
         }
         CallRecord record = caller.Call(rpc, clouds[next[rpc].fetch_add(1) % clouds.size()]);
         if (measured) {
@@ -318,6 +341,9 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   if (o.total == 0 && !(o.duration_seconds > 0.0))
     throw InvalidArgument("--total or --duration: give a positive call count or duration");
   if (o.rpcs.empty()) throw InvalidArgument("--rpc: no RPC to call");
+  if (!(o.rate >= 0.0) || !std::isfinite(o.rate))
+    throw InvalidArgument(
+        fmt::format("--rate: must be a finite number of calls per second >= 0, got {}", o.rate));
   if (o.concurrency % o.rpcs.size() != 0)
     throw InvalidArgument(
         fmt::format("--concurrency: {} is not a multiple of the {} RPCs of --rpc {} (each gets "
@@ -343,7 +369,7 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
                                       o.connect_timeout_seconds));
   const Caller caller(channel, o);
 
-  MeasuredPhase phase;
+  MeasuredPhase phase(o.rpcs.size());
   const std::vector<CallRecord> records = RunCalls(caller, calls, o, phase);
   const double elapsed = std::chrono::duration<double>(Clock::now() - phase.t0).count();
 
@@ -360,6 +386,8 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
   report.clouds = clouds.size();
   report.mean_cloud_bytes = cloud_bytes / static_cast<double>(clouds.size());
   report.warmup = o.warmup;
+  report.rate = o.rate;
+  report.max_start_lag_seconds = phase.max_start_lag_seconds;
   report.total = records.size();
   report.elapsed_seconds = elapsed;
   std::vector<double> ok_seconds;
@@ -408,6 +436,9 @@ std::string FormatLoadReportText(const LoadReport& r) {
   line(fmt::format("  Clouds:       {} (mean {} a cloud, {:.2f} M points)", r.clouds,
                    HumanBytes(r.mean_cloud_bytes), r.mean_cloud_bytes / 12.0 / 1e6));
   line(fmt::format("  Concurrency:  {}", r.concurrency));
+  if (r.rate > 0.0)
+    line(fmt::format("  Rate:         {:.3f} calls/s asked, started at most {:.3f} s late", r.rate,
+                     r.max_start_lag_seconds));
   line(fmt::format("  Count:        {} ({} OK){}", r.total, r.ok,
                    r.warmup ? fmt::format(", after {} warm-up", r.warmup) : ""));
   line(fmt::format("  Total:        {:.3f} s", r.elapsed_seconds));
@@ -482,6 +513,8 @@ std::string FormatLoadReportJson(const LoadReport& r) {
   j["clouds"] = r.clouds;
   j["mean_cloud_bytes"] = r.mean_cloud_bytes;
   j["warmup"] = r.warmup;
+  j["rate"] = r.rate;
+  j["max_start_lag_seconds"] = r.max_start_lag_seconds;
   j["count"] = r.total;
   j["ok"] = r.ok;
   j["total_seconds"] = r.elapsed_seconds;

@@ -56,6 +56,12 @@ struct LoadOptions {
   /// Measured phase length when total == 0, seconds: no call starts after it (calls in flight
   /// finish and count).
   double duration_seconds = 0.0;
+  /// Calls per second started in the measured phase (open loop: call k starts k / rate after the
+  /// phase begins, an RPC k % rpcs.size() call by one of that RPC's threads, or as soon as one is free
+  /// when the server is behind); 0 = closed loop, each thread calls again as soon as its call ends. A fixed
+  /// rate loads the server the same whatever the machine's speed, so its memory (the allocator's cache of
+  /// freed pages grows with the calls per second) can be compared between the start and the end of a run.
+  double rate = 0.0;
   /// Calls that complete before the measured phase (same concurrency), not counted. The phase starts
   /// when the last of them completes, with the other threads' calls still in flight (those are not
   /// counted either), so the server is in its steady state when measuring (and RSS sampling) begins.
@@ -123,6 +129,10 @@ struct LoadReport {
   /// Mean request payload (cloud bytes) per call.
   double mean_cloud_bytes = 0.0;
   std::uint64_t warmup = 0;
+  /// LoadOptions::rate (0 = closed loop), and the most a measured call started after its slot,
+  /// seconds: a server that cannot keep the rate lags.
+  double rate = 0.0;
+  double max_start_lag_seconds = 0.0;
   /// Measured calls (any status), of which `ok` succeeded.
   std::uint64_t total = 0;
   std::uint64_t ok = 0;
@@ -145,11 +155,12 @@ struct LoadReport {
 };
 
 /// Runs the load: connects, optionally warms up, then sends the clouds round-robin from
-/// `concurrency` threads (each with one call in flight) until `total` calls completed or
-/// `duration_seconds` passed. Call failures are counted by status code, never thrown.
+/// `concurrency` threads (each with one call in flight; at `rate` calls per second when given) until
+/// `total` calls completed or `duration_seconds` passed. Call failures are counted by status code, never
+/// thrown.
 /// @throws InvalidArgument for inconsistent options (no clouds, concurrency 0 or not a multiple of the
-///         number of RPCs, neither total nor duration) or when the target does not connect within
-///         connect_timeout_seconds.
+///         number of RPCs, neither total nor duration, a negative rate) or when the target does not connect
+///         within connect_timeout_seconds.
 LoadReport RunLoad(const LoadOptions& options, const std::vector<LoadCloud>& clouds);
 
 /// ghz-like text summary (several lines, ends with a newline).
