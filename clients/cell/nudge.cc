@@ -60,6 +60,69 @@ std::vector<Sample> SampleTube(const v1::Tube& tube, double spacing, double defa
   return samples;
 }
 
+// The samples of every tube but tubes[skip].
+std::vector<Sample> OtherTubes(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes, int skip,
+                               double spacing, double default_radius) {
+  std::vector<Sample> samples;
+  for (int i = 0; i < tubes.size(); ++i) {
+    if (i == skip) continue;
+    const std::vector<Sample> tube = SampleTube(tubes[i], spacing, default_radius);
+    samples.insert(samples.end(), tube.begin(), tube.end());
+  }
+  return samples;
+}
+
+// The tool's boxes at X_BinTcp moved by t · move_Bin, t in [0, 1]: the smallest t at which a box,
+// grown by a sample's radius and `clearance`, holds that sample's axis point, or nullopt when none
+// does. Per box and sample, the t where each TCP axis overlaps is an interval (the slab test); the
+// box holds the point where the three meet. Samples are spaced closer than twice the growth, so no
+// box slips between two of them.
+std::optional<double> FirstContact(const std::array<ToolBox, 3>& boxes, const Eigen::Isometry3d& X_BinTcp,
+                                   const Eigen::Vector3d& move_Bin, const std::vector<Sample>& obstacles,
+                                   double clearance) {
+  const Eigen::Isometry3d X_TcpBin = X_BinTcp.inverse();
+  const Eigen::Vector3d move_Tcp = X_TcpBin.linear() * move_Bin;
+  std::optional<double> first;
+  for (const Sample& obstacle : obstacles) {
+    const Eigen::Vector3d p_Tcp = X_TcpBin * obstacle.p_Bin;
+    for (const ToolBox& box : boxes) {
+      double lo = 0.0, hi = 1.0;
+      for (int axis = 0; axis < 3 && lo <= hi; ++axis) {
+        const double reach = box.half_size[axis] + obstacle.radius + clearance;
+        const double offset = p_Tcp[axis] - box.centre_Tcp[axis];  // overlap while |offset − t·move| ≤ reach
+        if (std::abs(move_Tcp[axis]) < 1e-12) {
+          if (std::abs(offset) > reach) hi = -1.0;
+          continue;
+        }
+        const double t0 = (offset - reach) / move_Tcp[axis], t1 = (offset + reach) / move_Tcp[axis];
+        lo = std::max(lo, std::min(t0, t1));
+        hi = std::min(hi, std::max(t0, t1));
+      }
+      if (lo <= hi && (!first || lo < *first)) first = lo;
+    }
+  }
+  return first;
+}
+
+// The push from X_BinTcpPress along `direction` that keeps the closed tool `clearance` from the other
+// tubes on the way down (from `lift` above), along the push and up: `distance`, or less where a tube
+// is in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
+std::optional<double> ClearPush(const ToolGeometry& tool, const Eigen::Isometry3d& X_BinTcpPress,
+                                const Eigen::Vector3d& direction, double distance, double min_push,
+                                double lift, const std::vector<Sample>& obstacles, double clearance) {
+  const std::array<ToolBox, 3> boxes = ToolBoxes(tool, 0.0);
+  const Eigen::Vector3d up(0.0, 0.0, lift);
+  if (FirstContact(boxes, X_BinTcpPress, up, obstacles, clearance)) return std::nullopt;
+  if (const std::optional<double> t =
+          FirstContact(boxes, X_BinTcpPress, distance * direction, obstacles, clearance))
+    distance *= *t;
+  if (distance < min_push) return std::nullopt;
+  Eigen::Isometry3d X_BinTcpPushed = X_BinTcpPress;
+  X_BinTcpPushed.translation() += distance * direction;
+  if (FirstContact(boxes, X_BinTcpPushed, up, obstacles, clearance)) return std::nullopt;
+  return distance;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan) {
@@ -98,6 +161,10 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
 
   for (const Candidate& candidate : candidates) {
     const v1::Tube& tube = tubes[candidate.index];
+    // Spaced at most one growth of the slab test apart (FirstContact).
+    const std::vector<Sample> others = OtherTubes(
+        tubes, candidate.index,
+        std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius), cell.tube.radius);
     std::vector<Sample> samples = SampleTube(tube, params.sample_spacing, cell.tube.radius);
     // Contact points along a wall, closest to the wanted fraction first.
     std::stable_sort(samples.begin(), samples.end(), [&](const Sample& a, const Sample& b) {
@@ -140,6 +207,10 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
         p_Bin_tip.z() = pad_bottom;
         X_BinTcpPress.translation() = p_Bin_tip - tool.finger_tip_depth * R_BinTcp.col(2);
         if (ToolClearanceProblem(cell, tool, X_BinTcpPress, 0.0, path)) continue;
+        const std::optional<double> push = ClearPush(tool, X_BinTcpPress, direction, plan.distance,
+                                                     params.min_push, lift, others, params.tube_clearance);
+        if (!push) continue;
+        plan.distance = *push;
         plan.shift = shift;
         plan.X_BinTcpPress = X_BinTcpPress;
         return plan;

@@ -35,6 +35,11 @@ struct NudgeParams {
   double max_push = 0.22;
   /// How far the pads' bottom goes below the tube's top, metres.
   double press_depth = 0.004;
+  /// The closed tool keeps this far from the other modeled tubes (their cylinders, grown by their
+  /// radius) on the way down to the press, along the push and on the way up, metres. A push that would
+  /// come closer stops short; none when that leaves less than min_push: a tool driven into the heap
+  /// meets tubes pinned by others, not a tube that slides.
+  double tube_clearance = 0.005;
   /// The tool leans this far from the vertical, its tips towards the wall and its housing towards
   /// the middle, so the pads reach over a tube close to the wall while the housing stays clear,
   /// radians (rotation about y_Tcp; the robot allows up to 60°). 0.4 rad ≈ 23°.
@@ -65,7 +70,9 @@ struct NudgePlan {
 /// A nudge for one of `tubes` (the planner's modeled tubes, bin frame), or nullopt when no tube
 /// lies along a wall or none can be pressed without the closed tool (ToolClearanceProblem, opening
 /// 0) touching a wall or the floor at the press pose, along the push or on the way up
-/// (`lift` metres). Tubes are tried non-occluded first, then by their distance to a wall (closest
+/// (`lift` metres), or without it coming within tube_clearance of another tube on its way down
+/// (from `lift` above the press), up, or along at least min_push of the push (the push then stops
+/// there). Tubes are tried non-occluded first, then by their distance to a wall (closest
 /// first); on a tube, the contact point is the sampled axis point along a wall closest to the
 /// fraction {0.5, 0.3, 0.7}[try_index % 3] of its length (so repeated nudges of the same tube
 /// push at different places). `tube_radius` is used for cylinders without a radius.

@@ -6,15 +6,16 @@
 #include <cstdio>
 
 namespace tubepick {
-namespace {
 
-struct Box {
-  const char* part;
-  Eigen::Vector3d centre_Tcp;
-  Eigen::Vector3d half_size;
-};
-
-}  // namespace
+std::array<ToolBox, 3> ToolBoxes(const ToolParams& tool, double opening) {
+  const double finger_z = tool.finger_tip_depth - 0.5 * tool.finger_size.z();
+  const double finger_y = 0.5 * (opening + tool.finger_size.y());
+  const double housing_z =
+      tool.finger_tip_depth - tool.finger_size.z() - tool.housing_gap - 0.5 * tool.housing_size.z();
+  return {ToolBox{"finger", Eigen::Vector3d(0.0, finger_y, finger_z), 0.5 * tool.finger_size},
+          ToolBox{"finger", Eigen::Vector3d(0.0, -finger_y, finger_z), 0.5 * tool.finger_size},
+          ToolBox{"housing", Eigen::Vector3d(0.0, 0.0, housing_z), 0.5 * tool.housing_size}};
+}
 
 std::string ToolClearanceIssue::ToString() const {
   char buffer[200];
@@ -33,21 +34,14 @@ std::string ToolClearanceIssue::ToString() const {
 std::optional<ToolClearanceIssue> ToolClearanceProblem(const BinConfig& bin, const ToolParams& tool,
                                                        const Eigen::Isometry3d& X_BinTcp, double opening,
                                                        const std::vector<Eigen::Vector3d>& waypoints) {
-  const double finger_z = tool.finger_tip_depth - 0.5 * tool.finger_size.z();
-  const double finger_y = 0.5 * (opening + tool.finger_size.y());
-  const double housing_z =
-      tool.finger_tip_depth - tool.finger_size.z() - tool.housing_gap - 0.5 * tool.housing_size.z();
-  const std::array<Box, 3> boxes = {
-      Box{"finger", Eigen::Vector3d(0.0, finger_y, finger_z), 0.5 * tool.finger_size},
-      Box{"finger", Eigen::Vector3d(0.0, -finger_y, finger_z), 0.5 * tool.finger_size},
-      Box{"housing", Eigen::Vector3d(0.0, 0.0, housing_z), 0.5 * tool.housing_size}};
+  const std::array<ToolBox, 3> boxes = ToolBoxes(tool, opening);
   const Eigen::Vector3d half_bin = 0.5 * bin.inner_size;
   const double wall_top = bin.inner_size.z();
   const std::size_t n = std::max<std::size_t>(1, waypoints.size());
   for (std::size_t w = 0; w < n; ++w) {
     Eigen::Isometry3d X = X_BinTcp;
     if (!waypoints.empty()) X.translation() += waypoints[w];
-    for (const Box& box : boxes) {
+    for (const ToolBox& box : boxes) {
       for (int corner = 0; corner < 8; ++corner) {
         const Eigen::Vector3d offset((corner & 1 ? 1 : -1) * box.half_size.x(),
                                      (corner & 2 ? 1 : -1) * box.half_size.y(),

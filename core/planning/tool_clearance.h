@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,18 @@ struct ToolParams {
   /// Distance the tool keeps from the bin's inner walls and floor, metres.
   double margin = 0.003;
 };
+
+/// One of the tool's boxes, TCP frame (axis-aligned there).
+struct ToolBox {
+  /// "finger" or "housing".
+  const char* part = "";
+  Eigen::Vector3d centre_Tcp = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();
+};
+
+/// The two pads and the housing of `tool` opened to `opening` (distance between the pads' inner
+/// faces, metres), in the TCP frame.
+std::array<ToolBox, 3> ToolBoxes(const ToolParams& tool, double opening);
 
 /// Where the tool would touch the bin (ToolClearanceIssue::ToString gives one line).
 struct ToolClearanceIssue {

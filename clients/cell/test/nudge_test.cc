@@ -88,6 +88,53 @@ TEST_F(NudgeTest, NonOccludedTubesGoFirstThenTheClosestToAWall) {
   EXPECT_EQ(PlanNudge(tubes, cell, tool, params, 0.1, 0)->tube_id, 2u);
 }
 
+TEST_F(NudgeTest, APushStopsShortOfTheNextTube) {
+  // The tube along the -y wall of the first test, and another on the floor 20 cm further in: the full
+  // push (0.22 m) would drive the pads into it.
+  *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
+  *tubes.Add() = StraightTube(5, {-0.25, -0.0765, kR}, {0.25, -0.0765, kR});
+  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->tube_id, 4u);
+  EXPECT_GE(plan->distance, params.min_push);
+  EXPECT_LT(plan->distance, params.max_push - 0.03);
+  // At the end of the push every tool box stays tube_clearance from the other tube's surface.
+  const Eigen::Vector3d end = plan->distance * plan->direction;
+  for (const ToolBox& box : ToolBoxes(tool, 0.0))
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d offset((corner & 1 ? 1 : -1) * box.half_size.x(),
+                                   (corner & 2 ? 1 : -1) * box.half_size.y(),
+                                   (corner & 4 ? 1 : -1) * box.half_size.z());
+      const Eigen::Vector3d p = plan->X_BinTcpPress * (box.centre_Tcp + offset) + end;
+      const double to_axis = std::hypot(p.y() + 0.0765, p.z() - kR);
+      EXPECT_TRUE(p.y() < -0.0765 - kR - params.tube_clearance + 1e-9 || to_axis > kR + params.tube_clearance)
+          << box.part << " corner " << corner << " at (" << p.transpose() << ")";
+    }
+  // Without the other tube the push is the full one.
+  tubes.RemoveLast();
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 0)->distance, params.max_push, 1e-12);
+}
+
+TEST_F(NudgeTest, ATubeTooCloseInFrontIsPushedInsteadAndOneInTheWayMovesTheContact) {
+  // A second tube 4 cm further in along the whole wall: no push of the outer tube gets min_push far,
+  // so the inner one (along the wall too) is pushed.
+  *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
+  *tubes.Add() = StraightTube(5, {-0.25, -0.2365, kR}, {0.25, -0.2365, kR});
+  const auto inner = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  ASSERT_TRUE(inner);
+  EXPECT_EQ(inner->tube_id, 5u);
+  EXPECT_NEAR(inner->distance, params.push_gain * (params.target_wall_distance - 0.0635), 1e-9);  // not cut
+
+  // A tube across the outer one's middle, 6 cm up on the heap, its end 11 cm from the wall (not along
+  // it): a push at the middle would drive the tool into it, so the outer tube is pressed elsewhere.
+  tubes.RemoveLast();
+  *tubes.Add() = StraightTube(6, {0.0, -0.19, 0.06}, {0.0, 0.1, 0.06});
+  const auto beside = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  ASSERT_TRUE(beside);
+  EXPECT_EQ(beside->tube_id, 4u);
+  EXPECT_GT(std::abs(beside->p_Bin_contact.x()), 0.05);
+}
+
 TEST_F(NudgeTest, TubeTooDeepInTheCornerOfFloorAndWallIsLeftAlone) {
   // Touching the wall: the pads cannot cover its top without the tool reaching into the wall.
   *tubes.Add() = StraightTube(0, {-0.2, -0.3 + kR, kR}, {0.2, -0.3 + kR, kR});
