@@ -21,7 +21,8 @@
 #    90`; samples taken while the last calls drain after 240 s count in no window; evenly spaced samples,
 #    so a mean is the time average):
 #    - every measured call answered OK (`--fail-on-error`);
-#    - no leak: the allocator's live bytes grew at most 10 % (`--max-allocated-growth 10`);
+#    - no leak: the allocator's live bytes per call in flight grew at most 10 % (`--max-allocated-growth
+#      10`; at a fixed rate the live bytes follow the calls in flight, so slower calls hold more);
 #    - flat memory: the RSS grew at most 10 % (`--max-rss-growth 10`). Under fresh load the RSS climbs
 #      for about a minute and then wanders about its working level (most of it is freed pages jemalloc
 #      keeps for ~10 s, as many as the calls of those seconds freed), while the live bytes stay within

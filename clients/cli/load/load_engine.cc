@@ -424,6 +424,13 @@ LoadReport RunLoad(const LoadOptions& o, const std::vector<LoadCloud>& clouds) {
     report.rss = phase.sampler->Stop(o.rss_window_seconds,
                                      o.total == 0 ? std::optional<double>(o.duration_seconds) : std::nullopt,
                                      o.rss_settle_seconds);
+  if (report.rss) {
+    std::vector<CallSpan> spans;
+    spans.reserve(report.calls.size());
+    for (const CallTiming& c : report.calls)
+      spans.push_back({c.start_unix_seconds - report.rss->start_unix_seconds, c.seconds});
+    AddCallsInFlight(*report.rss, spans);
+  }
   return report;
 }
 
@@ -499,6 +506,11 @@ std::string FormatLoadReportText(const LoadReport& r) {
             "  first {} allocated {}, last {} allocated {} ({:+.1f} %) (the allocator's live bytes)", first,
             HumanBytes(m.first_window_allocated_mean), last, HumanBytes(m.last_window_allocated_mean),
             m.allocated_growth_percent));
+      if (m.first_window_calls_in_flight > 0.0)
+        line(fmt::format(
+            "  first {} {:.2f} calls in flight, last {} {:.2f}: live bytes per call in flight {:+.1f} %",
+            first, m.first_window_calls_in_flight, last, m.last_window_calls_in_flight,
+            m.allocated_per_call_growth_percent));
     }
   }
   return out;
@@ -571,6 +583,9 @@ std::string FormatLoadReportJson(const LoadReport& r) {
                        {"first_window_allocated_mean_bytes", m.first_window_allocated_mean},
                        {"last_window_allocated_mean_bytes", m.last_window_allocated_mean},
                        {"allocated_growth_percent", m.allocated_growth_percent},
+                       {"first_window_calls_in_flight", m.first_window_calls_in_flight},
+                       {"last_window_calls_in_flight", m.last_window_calls_in_flight},
+                       {"allocated_per_call_growth_percent", m.allocated_per_call_growth_percent},
                        {"failed_scrapes", m.failed_scrapes},
                        {"samples", samples}};
   }

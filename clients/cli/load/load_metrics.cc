@@ -95,6 +95,7 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
     return s;
   }
   const double begin = s.samples.front().seconds + settle_seconds;
+  s.first_window_begin = begin;
   const double end = end_seconds.value_or(s.samples.back().seconds);
   s.end_seconds = end;
   std::vector<std::uint64_t> first;
@@ -149,6 +150,23 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
   return s;
 }
 
+void AddCallsInFlight(RssSummary& s, const std::vector<CallSpan>& calls) {
+  // Call-seconds inside [from, to], over its length.
+  const auto in_flight = [&calls](double from, double to) {
+    double busy = 0.0;
+    for (const CallSpan& c : calls)
+      busy += std::max(0.0, std::min(to, c.start + c.seconds) - std::max(from, c.start));
+    return to > from ? busy / (to - from) : 0.0;
+  };
+  const double first = in_flight(s.first_window_begin, s.first_window_begin + s.window_seconds);
+  const double last = in_flight(s.end_seconds - s.window_seconds, s.end_seconds);
+  if (!(first > 0.0) || !(last > 0.0) || !(s.first_window_allocated_mean > 0.0)) return;
+  s.first_window_calls_in_flight = first;
+  s.last_window_calls_in_flight = last;
+  s.allocated_per_call_growth_percent =
+      100.0 * ((s.last_window_allocated_mean / last) / (s.first_window_allocated_mean / first) - 1.0);
+}
+
 namespace {
 
 // Why either window is too thin to judge (the endpoint was not answering), or std::nullopt.
@@ -182,6 +200,18 @@ std::optional<std::string> AllocatedGrowthFailure(const RssSummary& s, double ma
     return std::string(
         "the server exported no tubepick_allocator_allocated_bytes in every scrape of both windows (a server "
         "without jemalloc, e.g. a sanitizer build): its live bytes cannot be judged");
+  if (s.first_window_calls_in_flight > 0.0) {
+    if (s.allocated_per_call_growth_percent <= max_growth_percent) return std::nullopt;
+    return fmt::format(
+        "the server's live bytes per call in flight grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean "
+        "of "
+        "the last {:.0f} s {:.1f} MB at {:.2f} calls in flight against {:.1f} MB at {:.2f} in the first "
+        "{:.0f} s "
+        "after {:.0f} s of settling), more than the {:.1f} % allowed: a leak",
+        s.allocated_per_call_growth_percent, s.window_seconds, s.last_window_allocated_mean / 1e6,
+        s.last_window_calls_in_flight, s.first_window_allocated_mean / 1e6, s.first_window_calls_in_flight,
+        s.window_seconds, s.settle_seconds, max_growth_percent);
+  }
   if (s.allocated_growth_percent > max_growth_percent)
     return fmt::format(
         "the server's live bytes grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean of the last "
@@ -193,7 +223,12 @@ std::optional<std::string> AllocatedGrowthFailure(const RssSummary& s, double ma
 }
 
 RssSampler::RssSampler(std::string url, std::chrono::milliseconds interval)
-    : url_(std::move(url)), interval_(interval), start_(Clock::now()), thread_([this] { Loop(); }) {}
+    : url_(std::move(url)),
+      interval_(interval),
+      start_(Clock::now()),
+      start_unix_seconds_(
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count()),
+      thread_([this] { Loop(); }) {}
 
 RssSampler::~RssSampler() {
   {
@@ -243,6 +278,7 @@ RssSummary RssSampler::Stop(double window_seconds, std::optional<double> end_sec
   summary.url = url_;
   summary.interval_seconds = std::chrono::duration<double>(interval_).count();
   summary.failed_scrapes = failed_;
+  summary.start_unix_seconds = start_unix_seconds_;
   return summary;
 }
 

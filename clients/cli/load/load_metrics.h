@@ -80,6 +80,24 @@ struct RssSummary {
   double first_window_allocated_mean = 0.0;
   double last_window_allocated_mean = 0.0;
   double allocated_growth_percent = 0.0;
+  /// Where the first window begins, seconds on the samples' clock.
+  double first_window_begin = 0.0;
+  /// When the sampler started (the samples' 0), seconds since the Unix epoch; 0 when not known.
+  double start_unix_seconds = 0.0;
+  /// Mean number of calls in flight over each window (AddCallsInFlight; 0 when not added), and the
+  /// change of the live bytes per call in flight, percent. Each call holds its cloud and what it
+  /// builds from it, so at a fixed rate (tubepick load --rate) the live bytes follow the calls in
+  /// flight, that is their latency, while a leak grows them per call; with a closed loop the calls in
+  /// flight are the concurrency and the two changes are the same.
+  double first_window_calls_in_flight = 0.0;
+  double last_window_calls_in_flight = 0.0;
+  double allocated_per_call_growth_percent = 0.0;
+};
+
+/// One measured call on the samples' clock: its start (seconds since the sampler started) and length.
+struct CallSpan {
+  double start = 0.0;
+  double seconds = 0.0;
 };
 
 /// Summarises samples (sorted by time) over windows of `window_seconds`: the first begins
@@ -88,6 +106,11 @@ struct RssSummary {
 RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
                         std::optional<double> end_seconds = std::nullopt, double settle_seconds = 0.0);
 
+/// Fills the calls-in-flight figures of `summary` (SummarizeRss's) from the run's calls: the time each
+/// call overlaps a window, summed, over the window's length. Leaves them 0 when either window has
+/// no call in flight or there are no live bytes to divide.
+void AddCallsInFlight(RssSummary& summary, const std::vector<CallSpan>& calls);
+
 /// Why a run fails the memory check, or std::nullopt when it passes: fails when either window holds
 /// fewer than `min_window_samples` samples, or when the mean RSS of the last window is more than
 /// `max_growth_percent` above the mean of the first. A fall is no failure (memory handed back).
@@ -95,8 +118,9 @@ std::optional<std::string> RssGrowthFailure(const RssSummary& summary, double ma
                                             std::size_t min_window_samples);
 
 /// Why a run fails the leak check, or std::nullopt when it passes: as RssGrowthFailure on the
-/// allocator's live bytes (first_window_allocated_mean against last_window_allocated_mean); also fails
-/// when the server did not export them.
+/// allocator's live bytes per call in flight when AddCallsInFlight filled them, else on the live bytes
+/// (first_window_allocated_mean against last_window_allocated_mean); also fails when the server did not
+/// export them.
 std::optional<std::string> AllocatedGrowthFailure(const RssSummary& summary, double max_growth_percent,
                                                   std::size_t min_window_samples);
 
@@ -121,6 +145,7 @@ class RssSampler {
   std::string url_;
   std::chrono::milliseconds interval_;
   std::chrono::steady_clock::time_point start_;
+  double start_unix_seconds_ = 0.0;
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stop_ = false;

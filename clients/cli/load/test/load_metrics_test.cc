@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -131,6 +133,41 @@ TEST(LoadMetrics, TheAllocatorsLiveBytesAreComparedWhenEverySampleHasThem) {
   const std::optional<std::string> unknown = AllocatedGrowthFailure(partial, 10.0, 15);
   ASSERT_TRUE(unknown.has_value());
   EXPECT_NE(unknown->find("exported no tubepick_allocator_allocated_bytes"), std::string::npos) << *unknown;
+}
+
+TEST(LoadMetrics, TheLiveBytesAreJudgedPerCallInFlight) {
+  // A fixed rate of one call a second; the calls take 0.5 s in the first window and 0.6 s in the last
+  // (a busier machine), and each holds 100 MB while in flight: the live bytes' window means grow +20 %,
+  // the live bytes per call in flight not at all.
+  std::vector<RssSample> samples;
+  std::vector<CallSpan> calls;
+  for (int k = 0; k < 120; ++k) calls.push_back({static_cast<double>(k), k < 60 ? 0.5 : 0.6});
+  for (int i = 0; i <= 1200; ++i) {
+    const double t = 0.1 * i;
+    const double into_call = t - std::floor(t);
+    const bool busy = into_call < (t < 60.0 ? 0.5 : 0.6) - 1e-9;
+    samples.push_back({t, 400'000'000, busy ? 100'000'000u : 1u});
+  }
+  RssSummary s = SummarizeRss(samples, 30.0, 120.0);
+  EXPECT_NEAR(s.allocated_growth_percent, 20.0, 1.0);
+  EXPECT_TRUE(
+      AllocatedGrowthFailure(s, 10.0, 15).has_value());  // read raw, the slower calls look like a leak
+  AddCallsInFlight(s, calls);
+  EXPECT_NEAR(s.first_window_calls_in_flight, 0.5, 0.02);
+  EXPECT_NEAR(s.last_window_calls_in_flight, 0.6, 0.02);
+  EXPECT_NEAR(s.allocated_per_call_growth_percent, 0.0, 2.0);
+  EXPECT_FALSE(AllocatedGrowthFailure(s, 10.0, 15).has_value());
+
+  // 40 MB more held from the last window on (a leak): +40 % per call in flight, named so.
+  for (RssSample& r : samples)
+    if (r.seconds >= 90.0) r.allocated_bytes += 40'000'000;
+  RssSummary leak = SummarizeRss(samples, 30.0, 120.0);
+  AddCallsInFlight(leak, calls);
+  EXPECT_GT(leak.allocated_per_call_growth_percent, 30.0);
+  const std::optional<std::string> failure = AllocatedGrowthFailure(leak, 10.0, 15);
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_NE(failure->find("live bytes per call in flight grew"), std::string::npos) << *failure;
+  EXPECT_NE(failure->find("at 0.60 calls in flight against"), std::string::npos) << *failure;
 }
 
 TEST(LoadMetrics, MedianIsTheNearestRank) {
