@@ -203,11 +203,9 @@ std::optional<std::string> AllocatedGrowthFailure(const RssSummary& s, double ma
   if (s.first_window_calls_in_flight > 0.0) {
     if (s.allocated_per_call_growth_percent <= max_growth_percent) return std::nullopt;
     return fmt::format(
-        "the server's live bytes per call in flight grew {:+.1f} % (tubepick_allocator_allocated_bytes, mean "
-        "of "
-        "the last {:.0f} s {:.1f} MB at {:.2f} calls in flight against {:.1f} MB at {:.2f} in the first "
-        "{:.0f} s "
-        "after {:.0f} s of settling), more than the {:.1f} % allowed: a leak",
+        "the server's live bytes per call in flight grew {:+.1f} % (tubepick_allocator_allocated_bytes, "
+        "mean of the last {:.0f} s {:.1f} MB at {:.2f} calls in flight against {:.1f} MB at {:.2f} in the "
+        "first {:.0f} s after {:.0f} s of settling), more than the {:.1f} % allowed: a leak",
         s.allocated_per_call_growth_percent, s.window_seconds, s.last_window_allocated_mean / 1e6,
         s.last_window_calls_in_flight, s.first_window_allocated_mean / 1e6, s.first_window_calls_in_flight,
         s.window_seconds, s.settle_seconds, max_growth_percent);
