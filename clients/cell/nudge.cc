@@ -104,13 +104,12 @@ std::optional<double> FirstContact(const std::array<ToolBox, 3>& boxes, const Ei
   return first;
 }
 
-// The push from X_BinTcpPress along `direction` that keeps the closed tool `clearance` from the other
-// tubes on the way down (from `lift` above), along the push and up: `distance`, or less where a tube
-// is in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
-std::optional<double> ClearPush(const ToolGeometry& tool, const Eigen::Isometry3d& X_BinTcpPress,
+// The push from X_BinTcpPress along `direction` that keeps the closed tool (`boxes`) `clearance` from the
+// other tubes on the way down (from `lift` above), along the push and up: `distance`, or less where a tube is
+// in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
+std::optional<double> ClearPush(const std::array<ToolBox, 3>& boxes, const Eigen::Isometry3d& X_BinTcpPress,
                                 const Eigen::Vector3d& direction, double distance, double min_push,
                                 double lift, const std::vector<Sample>& obstacles, double clearance) {
-  const std::array<ToolBox, 3> boxes = ToolBoxes(tool, 0.0);
   const Eigen::Vector3d up(0.0, 0.0, lift);
   if (FirstContact(boxes, X_BinTcpPress, up, obstacles, clearance)) return std::nullopt;
   if (const std::optional<double> t =
@@ -159,6 +158,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
     return a.wall_distance < b.wall_distance;
   });
 
+  const std::array<ToolBox, 3> closed_tool = ToolBoxes(tool, 0.0);
   for (const Candidate& candidate : candidates) {
     const v1::Tube& tube = tubes[candidate.index];
     // Spaced at most one growth of the slab test apart (FirstContact).
@@ -207,7 +207,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
         p_Bin_tip.z() = pad_bottom;
         X_BinTcpPress.translation() = p_Bin_tip - tool.finger_tip_depth * R_BinTcp.col(2);
         if (ToolClearanceProblem(cell, tool, X_BinTcpPress, 0.0, path)) continue;
-        const std::optional<double> push = ClearPush(tool, X_BinTcpPress, direction, plan.distance,
+        const std::optional<double> push = ClearPush(closed_tool, X_BinTcpPress, direction, plan.distance,
                                                      params.min_push, lift, others, params.tube_clearance);
         if (!push) continue;
         plan.distance = *push;

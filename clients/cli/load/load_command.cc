@@ -151,12 +151,10 @@ void AddLoadCommand(CLI::App& app) {
                   "percent (needs --metrics-url)")
       ->check(CLI::NonNegativeNumber)
       ->needs(metrics_url);
-  cmd->add_option(
-         "--max-allocated-growth", o->max_allocated_growth,
-         "Exit 1 when the server's mean live bytes (tubepick_allocator_allocated_bytes) per call in flight "
-         "of "
-         "the last window exceed those of the first by more than this, percent, or it does not export them "
-         "(needs --metrics-url)")
+  cmd->add_option("--max-allocated-growth", o->max_allocated_growth,
+                  "Exit 1 when the server's mean live bytes (tubepick_allocator_allocated_bytes) per call "
+                  "in flight of the last window exceed those of the first by more than this, percent, or it "
+                  "does not export them (needs --metrics-url)")
       ->check(CLI::NonNegativeNumber)
       ->needs(metrics_url);
   cmd->add_option("--connect-timeout", o->load.connect_timeout_seconds,

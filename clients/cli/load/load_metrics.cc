@@ -95,7 +95,6 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
     return s;
   }
   const double begin = s.samples.front().seconds + settle_seconds;
-  s.first_window_begin = begin;
   const double end = end_seconds.value_or(s.samples.back().seconds);
   s.end_seconds = end;
   std::vector<std::uint64_t> first;
@@ -158,7 +157,9 @@ void AddCallsInFlight(RssSummary& s, const std::vector<CallSpan>& calls) {
       busy += std::max(0.0, std::min(to, c.start + c.seconds) - std::max(from, c.start));
     return to > from ? busy / (to - from) : 0.0;
   };
-  const double first = in_flight(s.first_window_begin, s.first_window_begin + s.window_seconds);
+  if (s.samples.empty()) return;
+  const double begin = s.samples.front().seconds + s.settle_seconds;  // as SummarizeRss's first window
+  const double first = in_flight(begin, begin + s.window_seconds);
   const double last = in_flight(s.end_seconds - s.window_seconds, s.end_seconds);
   if (!(first > 0.0) || !(last > 0.0) || !(s.first_window_allocated_mean > 0.0)) return;
   s.first_window_calls_in_flight = first;

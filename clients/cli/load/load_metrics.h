@@ -80,8 +80,6 @@ struct RssSummary {
   double first_window_allocated_mean = 0.0;
   double last_window_allocated_mean = 0.0;
   double allocated_growth_percent = 0.0;
-  /// Where the first window begins, seconds on the samples' clock.
-  double first_window_begin = 0.0;
   /// When the sampler started (the samples' 0), seconds since the Unix epoch; 0 when not known.
   double start_unix_seconds = 0.0;
   /// Mean number of calls in flight over each window (AddCallsInFlight; 0 when not added), and the
