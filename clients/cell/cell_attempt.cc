@@ -570,23 +570,36 @@ std::optional<double> CellController::LoadOnTool(const devices::WrenchReading& r
 
 void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {
   Enter(CellState::kNudge);
+  // The fingers move only above the walls: closed before the tool goes down, opened after it is
+  // back up. In a heap as high as the walls, fingers opening at the approach height sweep 5 cm
+  // sideways into whatever lies there (seen in the simulated cell: 230 N on the two pads).
+  CloseGripper();
   Eigen::Isometry3d X_BinTcpAbovePress = plan.X_BinTcpPress;
   X_BinTcpAbovePress.translation().z() += params_.approach_height;
   TransitTo(X_BinTcpAbovePress, &attempt);
-  // The reference with the gripper open, as it will be after the push; then closed pads (nothing
-  // between them: approach_height above the tube) make one narrow block.
+  // The reference with the pads closed, as they stay until the check after the push.
   const devices::WrenchReading reference = ReadWrench();
   attempt.record["wrench"] = {{"reference", WrenchJson(reference)}};
-  CloseGripper();
   MoveTo(plan.X_BinTcpPress, params_.approach_speed, &attempt);
   MoveThrough(NudgePushWaypoints(plan), params_.nudge.speed, &attempt);
   const Eigen::Isometry3d X_BinTcpPushed = CurrentPose();
   MoveThrough({Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, params_.approach_height)},
               params_.approach_speed, &attempt);
-  OpenGripper();
   // A hose can hook over a pad while it is pushed: it must not ride home.
   CheckToolEmpty(reference, "after_nudge", X_BinTcpPushed, attempt);
+  OpenAboveTheWalls(&attempt);
   GoHome(&attempt);
+}
+
+/// Straight up to the transit height (if lower), then open: over the bin, clear of the heap.
+void CellController::OpenAboveTheWalls(Attempt* attempt) {
+  Eigen::Isometry3d X_BinTcpUp = CurrentPose();
+  const double transit_height = TransitHeight(params_, cell_);
+  if (X_BinTcpUp.translation().z() < transit_height) {
+    X_BinTcpUp.translation().z() = transit_height;
+    MoveTo(X_BinTcpUp, params_.approach_speed, attempt);
+  }
+  OpenGripper();
 }
 
 void CellController::GoHome(Attempt* attempt) {

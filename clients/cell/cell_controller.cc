@@ -552,7 +552,7 @@ std::optional<NudgePlan> CellController::PlanNudgeIfAllowed(const v1::PlanPickRe
       run.result.nudges >= params_.nudge.max_nudges_per_bin || response.tubes_size() == 0)
     return std::nullopt;
   return PlanNudge(response.tubes(), cell_, params_.tool, params_.nudge, params_.approach_height,
-                   run.nudges_since_pick);
+                   TransitHeight(params_, cell_), run.nudges_since_pick);
 }
 
 /// The nudge (kNudge) as the scan's attempt: `record` gets its plan, result and robot durations.

@@ -493,8 +493,11 @@ class CellController {
   /// nullopt otherwise.
   std::optional<double> LoadOnTool(const devices::WrenchReading& reference,
                                    const devices::WrenchReading& now) const;
-  /// The nudge skill's motions (kNudge), from home back to home.
+  /// The nudge skill's motions (kNudge), from home back to home; the fingers close before the tool
+  /// goes down and open only once it is back above the walls.
   void ExecuteNudge(const NudgePlan& plan, Attempt& attempt);
+  /// Straight up to the transit height (when lower), then open the gripper there.
+  void OpenAboveTheWalls(Attempt* attempt);
   void GoHome(Attempt* attempt);
 
   // Devices and planner calls (cell_device_calls.cc), each timed and its failures turned into

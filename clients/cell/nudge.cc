@@ -72,6 +72,17 @@ std::vector<Sample> OtherTubes(const google::protobuf::RepeatedPtrField<v1::Tube
   return samples;
 }
 
+// `others` and the samples of the pressed tube itself that lie more than a diameter above `contact`:
+// a branch or the far end of a steep piece, which the closed tool would pass through on its way down
+// to the contact or up from the push (the pads press and drag the rest of it).
+std::vector<Sample> Obstacles(const std::vector<Sample>& others, const std::vector<Sample>& own,
+                              const Sample& contact) {
+  std::vector<Sample> obstacles = others;
+  for (const Sample& s : own)
+    if (s.p_Bin.z() > contact.p_Bin.z() + 2.0 * contact.radius) obstacles.push_back(s);
+  return obstacles;
+}
+
 // The tool's boxes at X_BinTcp moved by t · move_Bin, t in [0, 1]: the smallest t at which a box,
 // grown by a sample's radius and `clearance`, holds that sample's axis point, or nullopt when none
 // does. Per box and sample, the t where each TCP axis overlaps is an interval (the slab test); the
@@ -105,12 +116,12 @@ std::optional<double> FirstContact(const std::array<ToolBox, 3>& boxes, const Ei
 }
 
 // The push from X_BinTcpPress along `direction` that keeps the closed tool (`boxes`) `clearance` from the
-// other tubes on the way down (from `lift` above), along the push and up: `distance`, or less where a tube is
-// in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
+// other tubes on the way down (from `rise` above), along the push and up (`rise` again): `distance`, or less
+// where a tube is in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
 std::optional<double> ClearPush(const std::array<ToolBox, 3>& boxes, const Eigen::Isometry3d& X_BinTcpPress,
                                 const Eigen::Vector3d& direction, double distance, double min_push,
-                                double lift, const std::vector<Sample>& obstacles, double clearance) {
-  const Eigen::Vector3d up(0.0, 0.0, lift);
+                                double rise, const std::vector<Sample>& obstacles, double clearance) {
+  const Eigen::Vector3d up(0.0, 0.0, rise);
   if (FirstContact(boxes, X_BinTcpPress, up, obstacles, clearance)) return std::nullopt;
   if (const std::optional<double> t =
           FirstContact(boxes, X_BinTcpPress, distance * direction, obstacles, clearance))
@@ -131,7 +142,8 @@ std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan) {
 
 std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
                                    const CellConfig& cell, const ToolGeometry& tool,
-                                   const NudgeParams& params, double lift, std::uint32_t try_index) {
+                                   const NudgeParams& params, double lift, double transit_z,
+                                   std::uint32_t try_index) {
   static constexpr std::array<double, 3> kFractions = {0.5, 0.3, 0.7};
   const double fraction = kFractions[try_index % kFractions.size()];
 
@@ -162,9 +174,10 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
   for (const Candidate& candidate : candidates) {
     const v1::Tube& tube = tubes[candidate.index];
     // Spaced at most one growth of the slab test apart (FirstContact).
-    const std::vector<Sample> others = OtherTubes(
-        tubes, candidate.index,
-        std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius), cell.tube.radius);
+    const double obstacle_spacing =
+        std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius);
+    const std::vector<Sample> others = OtherTubes(tubes, candidate.index, obstacle_spacing, cell.tube.radius);
+    const std::vector<Sample> own = SampleTube(tube, obstacle_spacing, cell.tube.radius);
     std::vector<Sample> samples = SampleTube(tube, params.sample_spacing, cell.tube.radius);
     // Contact points along a wall, closest to the wanted fraction first.
     std::stable_sort(samples.begin(), samples.end(), [&](const Sample& a, const Sample& b) {
@@ -199,6 +212,7 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
       const double max_shift = 0.5 * tool.finger_size.x() + 0.5 * s.radius;
       const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
                                                  plan.distance * direction + Eigen::Vector3d(0, 0, lift)};
+      const std::vector<Sample> obstacles = Obstacles(others, own, s);
       for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
         Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
         X_BinTcpPress.linear() = R_BinTcp;
@@ -207,8 +221,10 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
         p_Bin_tip.z() = pad_bottom;
         X_BinTcpPress.translation() = p_Bin_tip - tool.finger_tip_depth * R_BinTcp.col(2);
         if (ToolClearanceProblem(cell, tool, X_BinTcpPress, 0.0, path)) continue;
+        // The closed tool comes down from the transit height and goes back up to it.
+        const double rise = std::max(lift, transit_z - X_BinTcpPress.translation().z());
         const std::optional<double> push = ClearPush(closed_tool, X_BinTcpPress, direction, plan.distance,
-                                                     params.min_push, lift, others, params.tube_clearance);
+                                                     params.min_push, rise, obstacles, params.tube_clearance);
         if (!push) continue;
         plan.distance = *push;
         plan.shift = shift;

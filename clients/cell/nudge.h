@@ -71,14 +71,15 @@ struct NudgePlan {
 /// lies along a wall or none can be pressed without the closed tool (ToolClearanceProblem, opening
 /// 0) touching a wall or the floor at the press pose, along the push or on the way up
 /// (`lift` metres), or without it coming within tube_clearance of another tube on its way down
-/// (from `lift` above the press), up, or along at least min_push of the push (the push then stops
-/// there). Tubes are tried non-occluded first, then by their distance to a wall (closest
-/// first); on a tube, the contact point is the sampled axis point along a wall closest to the
-/// fraction {0.5, 0.3, 0.7}[try_index % 3] of its length (so repeated nudges of the same tube
-/// push at different places). `tube_radius` is used for cylinders without a radius.
+/// (from the bin-frame height `transit_z`, where the closed tool comes from), back up to it, or
+/// along at least min_push of the push (the push then stops there). Tubes are tried non-occluded first, then
+/// by their distance to a wall (closest first); on a tube, the contact point is the sampled axis point along
+/// a wall closest to the fraction {0.5, 0.3, 0.7}[try_index % 3] of its length (so repeated nudges of the
+/// same tube push at different places). `tube_radius` is used for cylinders without a radius.
 std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
                                    const CellConfig& cell, const ToolGeometry& tool,
-                                   const NudgeParams& params, double lift, std::uint32_t try_index);
+                                   const NudgeParams& params, double lift, double transit_z,
+                                   std::uint32_t try_index);
 
 /// Waypoints of the push and the lift after it, relative to X_BinTcpPress (for Robot::MoveThrough).
 std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan);

@@ -970,6 +970,30 @@ TEST_F(CellControllerTest, TubeAlongAWallWithoutExecutablePlanIsNudgedThenPicked
   EXPECT_EQ(Records("end").back()["nudges"], 1);
 }
 
+TEST_F(CellControllerTest, TheNudgeMovesItsFingersOnlyAboveTheWalls) {
+  // In a heap as high as the walls, fingers that open at the approach height sweep into the next
+  // tube. The nudge closes them before it goes down and opens them back up at the transit height.
+  planner.plan_answers.push_back(WallTubeWithoutPlan());
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.nudges, 1u);
+  EXPECT_EQ(Records("attempt")[0]["result"], "nudge");
+  const double transit_height = TransitHeight(params, cell);
+  ASSERT_EQ(gripper.closed_at.size(), 1u);
+  EXPECT_GE(gripper.closed_at[0].z(), transit_height - kTol) << gripper.closed_at[0].transpose();
+  // Opened once at the start of the round (home), once after the nudge: straight over the pushed pose.
+  ASSERT_EQ(gripper.opened_at.size(), 2u);
+  const json nudge = Records("attempt")[0]["nudge"];
+  const Eigen::Vector3d p_Bin_press(nudge["tcp_pose"]["position"][0].get<double>(),
+                                    nudge["tcp_pose"]["position"][1].get<double>(),
+                                    nudge["tcp_pose"]["position"][2].get<double>());
+  const Eigen::Vector3d push(0.0, nudge["distance"].get<double>(), 0.0);  // along +y
+  const Eigen::Vector3d& opened = gripper.opened_at[1];
+  EXPECT_NEAR(opened.z(), transit_height, kTol);
+  EXPECT_TRUE(opened.head<2>().isApprox((p_Bin_press + push).head<2>(), kTol)) << opened.transpose();
+  // The check after the push compares closed pads with closed pads: both read before the open.
+  EXPECT_TRUE(Records("attempt")[0]["wrench"].contains("after_nudge"));
+}
+
 TEST_F(CellControllerTest, NudgesStopAtTheirLimitAndScansThenOnlyRescan) {
   params.nudge.max_nudges_per_bin = 2;
   for (int i = 0; i < 4; ++i) planner.plan_answers.push_back(WallTubeWithoutPlan());

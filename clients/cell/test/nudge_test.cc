@@ -10,6 +10,8 @@ namespace tubepick::cell {
 namespace {
 
 constexpr double kR = 0.0125;
+// The tool goes up kLift after the push, and comes down from (and goes back up to) kTransitZ.
+constexpr double kLift = 0.1, kTransitZ = 0.5;
 
 v1::Tube StraightTube(std::uint32_t id, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                       v1::Occlusion occlusion = v1::OCCLUSION_NONE) {
@@ -34,7 +36,7 @@ class NudgeTest : public ::testing::Test {
 TEST_F(NudgeTest, TubeAlongTheMinusYWallIsPushedStraightOffIt) {
   // Axis 23.5 mm from the wall (11 mm between tube and wall): the last tube of a failed PVC round.
   *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
-  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  const auto plan = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
   ASSERT_TRUE(plan);
   EXPECT_EQ(plan->tube_id, 4u);
   EXPECT_NEAR(plan->direction.y(), 1.0, 1e-12);
@@ -57,19 +59,22 @@ TEST_F(NudgeTest, TubeAlongTheMinusYWallIsPushedStraightOffIt) {
   EXPECT_NEAR(tip.z(), 2.0 * kR - params.press_depth, 1e-9);
   EXPECT_LE(plan->shift, 0.5 * tool.finger_size.x() + 0.5 * kR + 1e-9);
   // Further tries push elsewhere along the tube: 0.3 and 0.7 of its length.
-  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 1)->p_Bin_contact.x(), -0.25 + 0.3 * 0.5, 0.011);
-  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 2)->p_Bin_contact.x(), -0.25 + 0.7 * 0.5, 0.011);
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 1)->p_Bin_contact.x(), -0.25 + 0.3 * 0.5,
+              0.011);
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 2)->p_Bin_contact.x(), -0.25 + 0.7 * 0.5,
+              0.011);
 }
 
 TEST_F(NudgeTest, TubeInACornerIsPushedDiagonally) {
   // Along the +x wall (8 cm from it), its upper end 5 cm from the +y wall.
   *tubes.Add() = StraightTube(0, {0.32, 0.0, kR}, {0.32, 0.25, kR});
   params.near_wall_distance = 0.09;
-  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 2);  // 0.7 of the length: y = 0.175
+  const auto plan =
+      PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 2);  // 0.7 of the length: y = 0.175
   ASSERT_TRUE(plan);
   EXPECT_NEAR(plan->direction.x(), -1.0, 1e-12);  // only the +x wall is within 9 cm of y = 0.175
   params.near_wall_distance = 0.16;
-  const auto corner = PlanNudge(tubes, cell, tool, params, 0.1, 2);
+  const auto corner = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 2);
   ASSERT_TRUE(corner);
   EXPECT_NEAR(corner->direction.x(), -std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(corner->direction.y(), -std::sqrt(0.5), 1e-9);
@@ -78,14 +83,14 @@ TEST_F(NudgeTest, TubeInACornerIsPushedDiagonally) {
 TEST_F(NudgeTest, NoNudgeForTubesAwayFromTheWallsOrWithoutGeometry) {
   *tubes.Add() = StraightTube(0, {-0.2, 0.0, kR}, {0.2, 0.0, kR});
   tubes.Add()->set_id(1);  // no cylinders
-  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, 0.1, 0));
+  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0));
 }
 
 TEST_F(NudgeTest, NonOccludedTubesGoFirstThenTheClosestToAWall) {
   *tubes.Add() = StraightTube(0, {-0.2, 0.28, kR}, {0.2, 0.28, kR}, v1::OCCLUSION_WEAK);
   *tubes.Add() = StraightTube(1, {-0.2, -0.25, kR}, {0.2, -0.25, kR});
   *tubes.Add() = StraightTube(2, {-0.2, -0.26, 3 * kR}, {0.2, -0.26, 3 * kR});
-  EXPECT_EQ(PlanNudge(tubes, cell, tool, params, 0.1, 0)->tube_id, 2u);
+  EXPECT_EQ(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0)->tube_id, 2u);
 }
 
 TEST_F(NudgeTest, APushStopsShortOfTheNextTube) {
@@ -93,7 +98,7 @@ TEST_F(NudgeTest, APushStopsShortOfTheNextTube) {
   // push (0.22 m) would drive the pads into it.
   *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
   *tubes.Add() = StraightTube(5, {-0.25, -0.0765, kR}, {0.25, -0.0765, kR});
-  const auto plan = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  const auto plan = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
   ASSERT_TRUE(plan);
   EXPECT_EQ(plan->tube_id, 4u);
   EXPECT_GE(plan->distance, params.min_push);
@@ -112,7 +117,7 @@ TEST_F(NudgeTest, APushStopsShortOfTheNextTube) {
     }
   // Without the other tube the push is the full one.
   tubes.RemoveLast();
-  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, 0.1, 0)->distance, params.max_push, 1e-12);
+  EXPECT_NEAR(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0)->distance, params.max_push, 1e-12);
 }
 
 TEST_F(NudgeTest, ATubeTooCloseInFrontIsPushedInsteadAndOneInTheWayMovesTheContact) {
@@ -120,7 +125,7 @@ TEST_F(NudgeTest, ATubeTooCloseInFrontIsPushedInsteadAndOneInTheWayMovesTheConta
   // so the inner one (along the wall too) is pushed.
   *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
   *tubes.Add() = StraightTube(5, {-0.25, -0.2365, kR}, {0.25, -0.2365, kR});
-  const auto inner = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  const auto inner = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
   ASSERT_TRUE(inner);
   EXPECT_EQ(inner->tube_id, 5u);
   EXPECT_NEAR(inner->distance, params.push_gain * (params.target_wall_distance - 0.0635), 1e-9);  // not cut
@@ -129,17 +134,54 @@ TEST_F(NudgeTest, ATubeTooCloseInFrontIsPushedInsteadAndOneInTheWayMovesTheConta
   // it): a push at the middle would drive the tool into it, so the outer tube is pressed elsewhere.
   tubes.RemoveLast();
   *tubes.Add() = StraightTube(6, {0.0, -0.19, 0.06}, {0.0, 0.1, 0.06});
-  const auto beside = PlanNudge(tubes, cell, tool, params, 0.1, 0);
+  const auto beside = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
   ASSERT_TRUE(beside);
   EXPECT_EQ(beside->tube_id, 4u);
   EXPECT_GT(std::abs(beside->p_Bin_contact.x()), 0.05);
+}
+
+TEST_F(NudgeTest, TheWayDownFromTheTransitHeightMustBeClear) {
+  // The tube along the -y wall, and a short one over its middle on the heap 0.32 m up: above what
+  // the tool sweeps from the press to kLift over it, but in the way of its descent from kTransitZ.
+  *tubes.Add() = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
+  *tubes.Add() = StraightTube(6, {-0.08, -0.25, 0.32}, {0.08, -0.25, 0.32});
+  const auto plan = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->tube_id, 4u);
+  EXPECT_GT(std::abs(plan->p_Bin_contact.x()), 0.05);
+  // Coming down from just above the lift, the middle is free.
+  EXPECT_LT(std::abs(PlanNudge(tubes, cell, tool, params, kLift, 0.0, 0)->p_Bin_contact.x()), 0.011);
+}
+
+TEST_F(NudgeTest, ABranchOfThePressedTreeAboveTheContactMovesIt) {
+  // A tree along the -y wall on the floor whose branch rises to 0.15 m, leaning over the trunk from
+  // the point the first nudge presses (half the tree's length along it: x = half the branch's
+  // length). Pressed there, the tool would come down through the branch.
+  const Eigen::Vector3d rise(0.0, 0.0565, 0.15 - kR);
+  const double x_root = 0.5 * rise.norm();
+  v1::Tube tree = StraightTube(4, {-0.25, -0.2765, kR}, {0.25, -0.2765, kR});
+  v1::Cylinder* branch = tree.add_cylinders();
+  *branch->mutable_start() = ToProto(Eigen::Vector3d(x_root, -0.2765, kR));
+  *branch->mutable_end() = ToProto(Eigen::Vector3d(x_root, -0.2765, kR) + rise);
+  branch->set_radius(kR);
+  *tubes.Add() = tree;
+  const auto plan = PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->tube_id, 4u);
+  EXPECT_LT(plan->p_Bin_contact.z(), 2.0 * kR);  // on the trunk, not up the branch
+  EXPECT_GT(std::abs(plan->p_Bin_contact.x() - x_root), 0.05);
+  // The same tree with the branch lying flat on the floor is pressed at the root.
+  *tubes.Mutable(0)->mutable_cylinders(1)->mutable_end() =
+      ToProto(Eigen::Vector3d(x_root, -0.2765 + rise.norm(), kR));
+  EXPECT_LT(std::abs(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0)->p_Bin_contact.x() - x_root),
+            0.011);
 }
 
 TEST_F(NudgeTest, TubeTooDeepInTheCornerOfFloorAndWallIsLeftAlone) {
   // Touching the wall: the pads cannot cover its top without the tool reaching into the wall.
   *tubes.Add() = StraightTube(0, {-0.2, -0.3 + kR, kR}, {0.2, -0.3 + kR, kR});
   params.tilt = 0.0;
-  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, 0.1, 0));
+  EXPECT_FALSE(PlanNudge(tubes, cell, tool, params, kLift, kTransitZ, 0));
 }
 
 }  // namespace

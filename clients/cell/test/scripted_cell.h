@@ -145,9 +145,9 @@ class ScriptedGripper final : public devices::Gripper {
   bool holding = false;
   /// From the n-th Status call on (0-based), the object is gone (a slip).
   std::optional<int> drop_at_status;
-  /// Where the TCP was at every successful Open (set by the test to the robot's pose).
+  /// Where the TCP was at every successful Open and Close (set by the test to the robot's pose).
   const Eigen::Isometry3d* tcp = nullptr;
-  std::vector<Eigen::Vector3d> opened_at;
+  std::vector<Eigen::Vector3d> opened_at, closed_at;
   std::vector<double> openings;
   /// Every command that moves the fingers (and activation) fails the test: a dry run must not move.
   bool forbid_motion = false;
@@ -177,6 +177,7 @@ class ScriptedGripper final : public devices::Gripper {
     if (forbid_motion) ADD_FAILURE() << "Gripper::Close called";
     ++closes;
     open = false;
+    if (tcp) closed_at.push_back(tcp->translation());
     devices::GripperStatus s;
     s.activated = true;
     s.object = devices::GripperObject::kStoppedClosing;
