@@ -76,6 +76,9 @@ std::string DescribeAttemptBriefly(const nlohmann::json& record) {
   const std::string result = record.value("result", "unfinished");
   if (result == "nudge") return fmt::format("no plan, nudged tube {}", record["nudge"].value("tube", 0u));
   if (result != "no_plan") return result;
+  if (const auto refused = record.find("nudge_not_repeated"); refused != record.end())
+    return fmt::format("no plan, tube {} not nudged again (the last nudge there moved nothing)",
+                       refused->at("nudge").value("tube", 0u));
   const std::size_t skipped = record.value("skipped_plans", nlohmann::json::array()).size();
   return skipped == 0 ? std::string("no plan")
                       : fmt::format("no plan ({} of {} skipped)", skipped, record.value("plans", 0));

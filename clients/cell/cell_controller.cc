@@ -459,6 +459,7 @@ void CellController::CountAttemptWrench(const Attempt& attempt, CellRunResult& r
 void CellController::RememberFailedGrasp(AttemptResult outcome, const Attempt& attempt, RunState& run) {
   if (outcome != AttemptResult::kNone && outcome != AttemptResult::kGraspFailed) {
     run.failed_grasps.clear();
+    run.nudges_done.clear();
     return;
   }
   if (!attempt.p_Bin_grasp) return;
@@ -519,9 +520,15 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
   // no nudge either (it would press where the planner, not the bin, has a tube).
   const bool cell_mismatch = scan.response.plans_size() > 0 &&
                              scan.cell_mismatches == static_cast<std::uint32_t>(scan.response.plans_size());
-  const std::optional<NudgePlan> nudge =
-      cell_mismatch ? std::nullopt : PlanNudgeIfAllowed(scan.response, run);
+  std::optional<NudgePlan> nudge = cell_mismatch ? std::nullopt : PlanNudgeIfAllowed(scan.response, run);
   nlohmann::json record = BaseRecord(scan, 0, run.result.attempts);
+  if (nudge) {
+    if (std::optional<std::string> repeat = RepeatsNudge(*nudge, run)) {
+      spdlog::warn("cell: round {} scan {}: {}", round_, scan.index, *repeat);
+      record["nudge_not_repeated"] = {{"nudge", NudgeJson(*nudge)}, {"reason", *repeat}};
+      nudge.reset();
+    }
+  }
   TakeVanishedOverWalls(scan, record);
   record["attempt"] = nullptr;
   record["result"] = "no_plan";
@@ -546,6 +553,29 @@ void CellController::NoExecutablePlan(PlannedScan& scan, RunState& run) {
                  scan.response.plans_size(), record["skipped_plans"].size());
 }
 
+/// The nudge presses where one since tubes last moved otherwise pressed, and the tube there lies as
+/// far from the wall: that one moved nothing (nudge.repeat_radius).
+std::optional<std::string> CellController::RepeatsNudge(const NudgePlan& nudge, const RunState& run) const {
+  const double radius = params_.nudge.repeat_radius;
+  if (radius <= 0.0) return std::nullopt;
+  for (const RunState::NudgeDone& done : run.nudges_done) {
+    const double distance = (nudge.p_Bin_contact - done.p_Bin_contact).norm();
+    if (distance > radius || std::abs(nudge.wall_distance - done.wall_distance) > radius) continue;
+    const Eigen::Vector3d& p = nudge.p_Bin_contact;
+    const double above_walls = p.z() - cell_.bin.inner_size.z();
+    return fmt::format(
+        "tube {} not nudged again: its contact at ({:.3f}, {:.3f}, {:.3f}) m, {:.3f} m from a wall, is "
+        "{:.3f} m "
+        "from the nudge of scan {}, which did not move it (nudge.repeat_radius {:.3f} m){}; clear it by hand "
+        "if no plan comes",
+        nudge.tube_id, p.x(), p.y(), p.z(), nudge.wall_distance, distance, done.scan, radius,
+        above_walls > 0.0
+            ? fmt::format(": {:.3f} m above the wall top, it may hang over the wall", above_walls)
+            : ": it may be caught or wedged");
+  }
+  return std::nullopt;
+}
+
 std::optional<NudgePlan> CellController::PlanNudgeIfAllowed(const v1::PlanPickResponse& response,
                                                             const RunState& run) const {
   if (!params_.nudge.enabled || !params_.check_tool_clearance ||
@@ -560,6 +590,7 @@ nlohmann::json CellController::Nudge(const NudgePlan& nudge, nlohmann::json reco
                                      RunState& run) {
   ++run.result.nudges;
   ++run.nudges_since_pick;
+  run.nudges_done.push_back({nudge.p_Bin_contact, nudge.wall_distance, scan.index});
   run.touched.push_back(nudge.tube_id);
   record["nudge"] = NudgeJson(nudge);
   Attempt& attempt = run.active.emplace();

@@ -374,6 +374,8 @@ class CellController {
   void NoExecutablePlan(PlannedScan& scan, RunState& run);
   std::optional<NudgePlan> PlanNudgeIfAllowed(const v1::PlanPickResponse& response,
                                               const RunState& run) const;
+  /// Why `nudge` would repeat a nudge that moved nothing (nudge.repeat_radius), or nullopt.
+  std::optional<std::string> RepeatsNudge(const NudgePlan& nudge, const RunState& run) const;
   nlohmann::json Nudge(const NudgePlan& nudge, nlohmann::json record, const PlannedScan& scan, RunState& run);
   /// The "type": "attempt" record's common fields; truth_before is the scan's for rank 0.
   nlohmann::json BaseRecord(const PlannedScan& scan, int rank, std::uint32_t attempt);

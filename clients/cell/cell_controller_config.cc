@@ -70,10 +70,13 @@ void DescribeFields(Visit& v, NudgeParams& n) {
   v("min_push", n.min_push);
   v("max_push", n.max_push);
   v("press_depth", n.press_depth, "m of the pads below the tube's top");
-  v("tube_clearance", n.tube_clearance, "m the tool keeps from the other modeled tubes; a push stops short");
+  v("tube_clearance", n.tube_clearance,
+    "m kept from other tubes and the pressed one's top; a push stops short");
   v("tilt", n.tilt, "rad from the vertical, tips towards the wall");
   v("speed", n.speed, "m/s");
   v("sample_spacing", n.sample_spacing, "m along the tube");
+  v("repeat_radius", n.repeat_radius,
+    "m: a nudge this close to an earlier one that moved nothing is not done");
 }
 
 template <typename Visit>

@@ -133,6 +133,13 @@ struct CellController::RunState {
     std::string result;
   };
   std::vector<FailedGrasp> failed_grasps;
+  /// Nudges since tubes last moved otherwise (a pick, a put-back, a lost tube): nudge.repeat_radius.
+  struct NudgeDone {
+    Eigen::Vector3d p_Bin_contact = Eigen::Vector3d::Zero();
+    double wall_distance = 0.0;
+    std::uint32_t scan = 0;
+  };
+  std::vector<NudgeDone> nudges_done;
   std::optional<Attempt> active;
   /// The last scan's tubes hanging over a wall, and the tubes attempted or nudged since.
   std::vector<TubeOverWall> over_walls;

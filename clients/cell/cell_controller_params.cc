@@ -81,6 +81,7 @@ void CellControllerParams::Validate() const {
                                       nudge.min_push, nudge.max_push));
   RequireNonNegativeValue(nudge.press_depth, "nudge.press_depth");
   RequireNonNegativeValue(nudge.tube_clearance, "nudge.tube_clearance");
+  RequireNonNegativeValue(nudge.repeat_radius, "nudge.repeat_radius");
   if (!std::isfinite(nudge.tilt) || nudge.tilt < 0.0 || nudge.tilt >= M_PI / 2)
     throw InvalidArgument(
         fmt::format("cell controller nudge.tilt: must be in [0, pi/2) rad, got {}", nudge.tilt));

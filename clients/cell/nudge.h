@@ -48,6 +48,11 @@ struct NudgeParams {
   double speed = 0.05;
   /// Sample spacing along the tube when looking for the contact point, metres.
   double sample_spacing = 0.02;
+  /// A nudge whose contact lies within this of an earlier nudge's, with the tube as far from the
+  /// wall, since tubes last moved otherwise (a pick, a put-back, a lost tube), would repeat a push
+  /// that moved nothing there (a tube hanging over a wall, or caught): it is not done, and the scan
+  /// says so. Metres; 0 = nudges repeat freely (up to max_nudges_per_bin).
+  double repeat_radius = 0.005;
 };
 
 /// One planned nudge, bin frame.

@@ -1019,6 +1019,36 @@ TEST_F(CellControllerTest, NudgesStopAtTheirLimitAndScansThenOnlyRescan) {
       << limited.message;
 }
 
+TEST_F(CellControllerTest, ANudgeThatMovedNothingIsNotRepeated) {
+  // The same tube along the wall in every scan: the nudges press at 0.5, 0.3 and 0.7 of its length;
+  // the fourth would press at 0.5 again, where the first moved nothing.
+  params.max_consecutive_failures = 5;
+  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(WallTubeWithoutPlan());
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.nudges, 3u);
+  EXPECT_EQ(result.reason, CellStopReason::kLimitReached);
+  const std::vector<json> records = Records("attempt");
+  ASSERT_EQ(records.size(), 5u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(records[i]["result"], "nudge") << i;
+  EXPECT_EQ(records[3]["result"], "no_plan");
+  ASSERT_TRUE(records[3].contains("nudge_not_repeated"));
+  const std::string reason = records[3]["nudge_not_repeated"]["reason"].get<std::string>();
+  EXPECT_THAT(reason,
+              ::testing::HasSubstr("tube 0 not nudged again: its contact at (0.000, -0.270, 0.013) m, "
+                                   "0.030 m from a wall, is 0.000 m from the nudge of scan 0, which "
+                                   "did not move it (nudge.repeat_radius 0.005 m): it may be caught"));
+  EXPECT_NEAR(records[3]["nudge_not_repeated"]["nudge"]["contact"][0].get<double>(),
+              records[0]["nudge"]["contact"][0].get<double>(), 1e-9);
+  EXPECT_THAT(result.message,
+              ::testing::HasSubstr("nudged tube 0, no plan, tube 0 not nudged again (the last "
+                                   "nudge there moved nothing)"));
+  // Without the rule, the fourth and fifth scans nudge again.
+  params.nudge.repeat_radius = 0.0;
+  sink = MemoryRecordSink{};
+  for (int i = 0; i < 5; ++i) planner.plan_answers.push_back(WallTubeWithoutPlan());
+  EXPECT_EQ(Run().nudges, 5u);
+}
+
 TEST_F(CellControllerTest, NudgeDisabledOrWithoutGeometryIsANoPlanScan) {
   params.nudge.enabled = false;
   planner.plan_answers.push_back(WallTubeWithoutPlan());
