@@ -564,10 +564,11 @@ std::optional<std::string> CellController::RepeatsNudge(const NudgePlan& nudge, 
     const Eigen::Vector3d& p = nudge.p_Bin_contact;
     const double above_walls = p.z() - cell_.bin.inner_size.z();
     return fmt::format(
-        "tube {} not nudged again: its contact at ({:.3f}, {:.3f}, {:.3f}) m, {:.3f} m from a wall, is "
-        "{:.3f} m "
-        "from the nudge of scan {}, which did not move it (nudge.repeat_radius {:.3f} m){}; clear it by hand "
-        "if no plan comes",
+        "tube {} not nudged again: "
+        "its contact at ({:.3f}, {:.3f}, {:.3f}) m, {:.3f} m from a wall, "
+        "is {:.3f} m from the nudge of scan {}, which did not move it "
+        "(nudge.repeat_radius {:.3f} m){}; "
+        "clear it by hand if no plan comes",
         nudge.tube_id, p.x(), p.y(), p.z(), nudge.wall_distance, distance, done.scan, radius,
         above_walls > 0.0
             ? fmt::format(": {:.3f} m above the wall top, it may hang over the wall", above_walls)

@@ -1033,15 +1033,15 @@ TEST_F(CellControllerTest, ANudgeThatMovedNothingIsNotRepeated) {
   EXPECT_EQ(records[3]["result"], "no_plan");
   ASSERT_TRUE(records[3].contains("nudge_not_repeated"));
   const std::string reason = records[3]["nudge_not_repeated"]["reason"].get<std::string>();
-  EXPECT_THAT(reason,
-              ::testing::HasSubstr("tube 0 not nudged again: its contact at (0.000, -0.270, 0.013) m, "
-                                   "0.030 m from a wall, is 0.000 m from the nudge of scan 0, which "
-                                   "did not move it (nudge.repeat_radius 0.005 m): it may be caught"));
+  EXPECT_THAT(reason, ::testing::HasSubstr("tube 0 not nudged again: "
+                                           "its contact at (0.000, -0.270, 0.013) m, 0.030 m from a wall, "
+                                           "is 0.000 m from the nudge of scan 0, which did not move it "
+                                           "(nudge.repeat_radius 0.005 m): it may be caught"));
   EXPECT_NEAR(records[3]["nudge_not_repeated"]["nudge"]["contact"][0].get<double>(),
               records[0]["nudge"]["contact"][0].get<double>(), 1e-9);
   EXPECT_THAT(result.message,
-              ::testing::HasSubstr("nudged tube 0, no plan, tube 0 not nudged again (the last "
-                                   "nudge there moved nothing)"));
+              ::testing::HasSubstr("nudged tube 0, "
+                                   "no plan, tube 0 not nudged again (the last nudge there moved nothing)"));
   // Without the rule, the fourth and fifth scans nudge again.
   params.nudge.repeat_radius = 0.0;
   sink = MemoryRecordSink{};
