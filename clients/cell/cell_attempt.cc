@@ -21,6 +21,7 @@
 namespace tubepick::cell {
 using detail::CallDevice;
 using detail::PlannerPose;
+using detail::WithHeight;
 
 namespace {
 
@@ -593,12 +594,10 @@ void CellController::ExecuteNudge(const NudgePlan& plan, Attempt& attempt) {
 
 /// Straight up to the transit height (if lower), then open: over the bin, clear of the heap.
 void CellController::OpenAboveTheWalls(Attempt* attempt) {
-  Eigen::Isometry3d X_BinTcpUp = CurrentPose();
+  const Eigen::Isometry3d X_BinTcp = CurrentPose();
   const double transit_height = TransitHeight(params_, cell_);
-  if (X_BinTcpUp.translation().z() < transit_height) {
-    X_BinTcpUp.translation().z() = transit_height;
-    MoveTo(X_BinTcpUp, params_.approach_speed, attempt);
-  }
+  if (X_BinTcp.translation().z() < transit_height)
+    MoveTo(WithHeight(X_BinTcp, transit_height), params_.approach_speed, attempt);
   OpenGripper();
 }
 

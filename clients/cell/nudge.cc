@@ -72,15 +72,20 @@ std::vector<Sample> OtherTubes(const google::protobuf::RepeatedPtrField<v1::Tube
   return samples;
 }
 
-// `others` and the samples of the pressed tube itself that lie more than a diameter above `contact`:
-// a branch or the far end of a steep piece, which the closed tool would pass through on its way down
-// to the contact or up from the push (the pads press and drag the rest of it).
-std::vector<Sample> Obstacles(const std::vector<Sample>& others, const std::vector<Sample>& own,
-                              const Sample& contact) {
-  std::vector<Sample> obstacles = others;
+// What the closed tool must keep clear of: the other tubes, and the pressed one's parts above the contact.
+struct Obstacles {
+  const std::vector<Sample>& others;
+  const std::vector<Sample>& own_above;
+};
+
+// The samples of the pressed tube itself that lie more than a diameter above `contact`: a branch or
+// the far end of a steep piece, which the closed tool would pass through on its way down to the
+// contact or up from the push (the pads press and drag the rest of it).
+std::vector<Sample> OwnAbove(const std::vector<Sample>& own, const Sample& contact) {
+  std::vector<Sample> above;
   for (const Sample& s : own)
-    if (s.p_Bin.z() > contact.p_Bin.z() + 2.0 * contact.radius) obstacles.push_back(s);
-  return obstacles;
+    if (s.p_Bin.z() > contact.p_Bin.z() + 2.0 * contact.radius) above.push_back(s);
+  return above;
 }
 
 // The tool's boxes at X_BinTcp moved by t · move_Bin, t in [0, 1]: the smallest t at which a box,
@@ -89,27 +94,30 @@ std::vector<Sample> Obstacles(const std::vector<Sample>& others, const std::vect
 // box holds the point where the three meet. Samples are spaced closer than twice the growth, so no
 // box slips between two of them.
 std::optional<double> FirstContact(const std::array<ToolBox, 3>& boxes, const Eigen::Isometry3d& X_BinTcp,
-                                   const Eigen::Vector3d& move_Bin, const std::vector<Sample>& obstacles,
+                                   const Eigen::Vector3d& move_Bin, const Obstacles& obstacles,
                                    double clearance) {
   const Eigen::Isometry3d X_TcpBin = X_BinTcp.inverse();
   const Eigen::Vector3d move_Tcp = X_TcpBin.linear() * move_Bin;
   std::optional<double> first;
-  for (const Sample& obstacle : obstacles) {
-    const Eigen::Vector3d p_Tcp = X_TcpBin * obstacle.p_Bin;
-    for (const ToolBox& box : boxes) {
-      double lo = 0.0, hi = 1.0;
-      for (int axis = 0; axis < 3 && lo <= hi; ++axis) {
-        const double reach = box.half_size[axis] + obstacle.radius + clearance;
-        const double offset = p_Tcp[axis] - box.centre_Tcp[axis];  // overlap while |offset − t·move| ≤ reach
-        if (std::abs(move_Tcp[axis]) < 1e-12) {
-          if (std::abs(offset) > reach) hi = -1.0;
-          continue;
+  for (const std::vector<Sample>* list : {&obstacles.others, &obstacles.own_above}) {
+    for (const Sample& obstacle : *list) {
+      const Eigen::Vector3d p_Tcp = X_TcpBin * obstacle.p_Bin;
+      for (const ToolBox& box : boxes) {
+        double lo = 0.0, hi = 1.0;
+        for (int axis = 0; axis < 3 && lo <= hi; ++axis) {
+          const double reach = box.half_size[axis] + obstacle.radius + clearance;
+          const double offset =
+              p_Tcp[axis] - box.centre_Tcp[axis];  // overlap while |offset − t·move| ≤ reach
+          if (std::abs(move_Tcp[axis]) < 1e-12) {
+            if (std::abs(offset) > reach) hi = -1.0;
+            continue;
+          }
+          const double t0 = (offset - reach) / move_Tcp[axis], t1 = (offset + reach) / move_Tcp[axis];
+          lo = std::max(lo, std::min(t0, t1));
+          hi = std::min(hi, std::max(t0, t1));
         }
-        const double t0 = (offset - reach) / move_Tcp[axis], t1 = (offset + reach) / move_Tcp[axis];
-        lo = std::max(lo, std::min(t0, t1));
-        hi = std::min(hi, std::max(t0, t1));
+        if (lo <= hi && (!first || lo < *first)) first = lo;
       }
-      if (lo <= hi && (!first || lo < *first)) first = lo;
     }
   }
   return first;
@@ -120,7 +128,7 @@ std::optional<double> FirstContact(const std::array<ToolBox, 3>& boxes, const Ei
 // where a tube is in the way; nullopt when that is less than `min_push` or the way down or up is blocked.
 std::optional<double> ClearPush(const std::array<ToolBox, 3>& boxes, const Eigen::Isometry3d& X_BinTcpPress,
                                 const Eigen::Vector3d& direction, double distance, double min_push,
-                                double rise, const std::vector<Sample>& obstacles, double clearance) {
+                                double rise, const Obstacles& obstacles, double clearance) {
   const Eigen::Vector3d up(0.0, 0.0, rise);
   if (FirstContact(boxes, X_BinTcpPress, up, obstacles, clearance)) return std::nullopt;
   if (const std::optional<double> t =
@@ -171,11 +179,11 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
   });
 
   const std::array<ToolBox, 3> closed_tool = ToolBoxes(tool, 0.0);
+  // Obstacle samples spaced at most one growth of the slab test apart (FirstContact).
+  const double obstacle_spacing =
+      std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius);
   for (const Candidate& candidate : candidates) {
     const v1::Tube& tube = tubes[candidate.index];
-    // Spaced at most one growth of the slab test apart (FirstContact).
-    const double obstacle_spacing =
-        std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius);
     const std::vector<Sample> others = OtherTubes(tubes, candidate.index, obstacle_spacing, cell.tube.radius);
     const std::vector<Sample> own = SampleTube(tube, obstacle_spacing, cell.tube.radius);
     std::vector<Sample> samples = SampleTube(tube, params.sample_spacing, cell.tube.radius);
@@ -212,7 +220,8 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
       const double max_shift = 0.5 * tool.finger_size.x() + 0.5 * s.radius;
       const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
                                                  plan.distance * direction + Eigen::Vector3d(0, 0, lift)};
-      const std::vector<Sample> obstacles = Obstacles(others, own, s);
+      const std::vector<Sample> own_above = OwnAbove(own, s);
+      const Obstacles obstacles{others, own_above};
       for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
         Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
         X_BinTcpPress.linear() = R_BinTcp;

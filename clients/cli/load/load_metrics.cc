@@ -94,7 +94,7 @@ RssSummary SummarizeRss(std::vector<RssSample> samples, double window_seconds,
     s.end_seconds = end_seconds.value_or(0.0);
     return s;
   }
-  const double begin = s.samples.front().seconds + settle_seconds;
+  const double begin = s.FirstWindowBegin();
   const double end = end_seconds.value_or(s.samples.back().seconds);
   s.end_seconds = end;
   std::vector<std::uint64_t> first;
@@ -158,7 +158,7 @@ void AddCallsInFlight(RssSummary& s, const std::vector<CallSpan>& calls) {
     return to > from ? busy / (to - from) : 0.0;
   };
   if (s.samples.empty()) return;
-  const double begin = s.samples.front().seconds + s.settle_seconds;  // as SummarizeRss's first window
+  const double begin = s.FirstWindowBegin();
   const double first = in_flight(begin, begin + s.window_seconds);
   const double last = in_flight(s.end_seconds - s.window_seconds, s.end_seconds);
   if (!(first > 0.0) || !(last > 0.0) || !(s.first_window_allocated_mean > 0.0)) return;

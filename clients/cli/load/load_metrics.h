@@ -90,6 +90,9 @@ struct RssSummary {
   double first_window_calls_in_flight = 0.0;
   double last_window_calls_in_flight = 0.0;
   double allocated_per_call_growth_percent = 0.0;
+
+  /// Where the first window begins: settle_seconds after the first sample (0 without samples).
+  double FirstWindowBegin() const { return samples.empty() ? 0.0 : samples.front().seconds + settle_seconds; }
 };
 
 /// One measured call on the samples' clock: its start (seconds since the sampler started) and length.
