@@ -47,6 +47,8 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.nudge.tilt, b.nudge.tilt);
   EXPECT_EQ(a.nudge.speed, b.nudge.speed);
   EXPECT_EQ(a.nudge.sample_spacing, b.nudge.sample_spacing);
+  EXPECT_EQ(a.nudge.tube_clearance, b.nudge.tube_clearance);
+  EXPECT_EQ(a.nudge.repeat_radius, b.nudge.repeat_radius);
   EXPECT_EQ(a.cell_check.enabled, b.cell_check.enabled);
   EXPECT_EQ(a.cell_check.bin_margin, b.cell_check.bin_margin);
   EXPECT_EQ(a.cell_check.place_position_tolerance, b.cell_check.place_position_tolerance);
@@ -343,6 +345,18 @@ TEST(CellControllerConfigTest, CellCheckKeysAreReadAndCheckedNamingThem) {
       0.25);
   EXPECT_NE(ParseError("cell_check:\n  margin: 0.1\n").find("cell_check.margin"), std::string::npos);
   EXPECT_NE(ParseError("cell_check:\n  enabled: perhaps\n").find("cell_check.enabled"), std::string::npos);
+}
+
+TEST(CellControllerConfigTest, NudgeClearanceAndRepeatKeysAreReadAndCheckedNamingThem) {
+  const CellControllerParams p =
+      ParseCellControllerParams("nudge:\n  tube_clearance: 0.01\n  repeat_radius: 0.002\n");
+  EXPECT_EQ(p.nudge.tube_clearance, 0.01);
+  EXPECT_EQ(p.nudge.repeat_radius, 0.002);
+  for (const std::string key : {"tube_clearance", "repeat_radius"}) {
+    const std::string error = ParseError("nudge:\n  " + key + ": -0.01\n");
+    EXPECT_NE(error.find("nudge." + key + ": must be a non-negative number, got -0.01"), std::string::npos)
+        << error;
+  }
 }
 
 TEST(CellControllerConfigTest, TubeMassCheckKeysAreReadAndCheckedNamingThem) {
