@@ -264,4 +264,12 @@ const SimFaultEvents& SimCell::fault_events() const { return impl_->state.events
 
 bool SimCell::settled() const { return impl_->state.settled; }
 
+std::vector<SimRunaway> SimCell::runaways() const {
+  std::vector<SimRunaway> out = impl_->state.world->runaways();
+  for (SimRunaway& r : out) r.seconds -= impl_->state.start_time;
+  return out;
+}
+
+SimPeakSpeeds SimCell::peak_speeds() const { return impl_->state.world->peak_speeds(); }
+
 }  // namespace tubepick::devices::sim

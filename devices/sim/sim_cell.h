@@ -152,6 +152,32 @@ struct SimPhysicsParams {
   /// Bin wall thickness in the physics world, metres (inner faces as in the cell; thick walls
   /// stop tubes pushed by the fingers from tunnelling through).
   double wall_thickness = 0.05;
+  /// A tube body whose centre of mass moves faster than this, m/s, is a runaway (SimRunaway):
+  /// nothing in the cell moves a tube that fast (the arm at most 1 m/s, a tube falling from the
+  /// transit height onto the ground 3-4 m/s; the fastest body of rounds without a blow-up
+  /// 1.4-2.3 m/s, docs/ACCURACY.md). Spin is no criterion: a rubber hose's short links spin at up
+  /// to 47 rad/s in such rounds, a pvc tree at 21, the blow-up traced at 41-62.
+  double runaway_speed = 6.0;
+};
+
+/// A tube that moved faster than anything in the cell can move it (SimPhysicsParams::runaway_speed):
+/// the solver put energy into it (a blow-up of the simulation, e.g. rigid
+/// trees locked into each other), and where it goes next is the simulator's doing, not the cell's.
+/// The first such step of each tube.
+struct SimRunaway {
+  /// Index into SimCell::TubesBin.
+  std::size_t tube = 0;
+  /// SimCell::SimulatedSeconds when it happened (negative: while the bin settled).
+  double seconds = 0.0;
+  /// The fastest of the tube's bodies then, m/s and rad/s.
+  double speed = 0.0;
+  double angular_speed = 0.0;
+};
+
+/// The fastest any tube body moved, m/s and rad/s.
+struct SimPeakSpeeds {
+  double linear = 0.0;
+  double angular = 0.0;
 };
 
 /// Everything that defines one simulated cell. Same params (incl. seed) ⇒ same cell, same scans,
@@ -325,6 +351,11 @@ class SimCell {
   const SimFaultEvents& fault_events() const;
   /// The tubes were at rest when construction ended (false: settle_time ran out).
   bool settled() const;
+  /// Tubes that ran away (SimRunaway), in the order it happened; empty when the simulation stayed
+  /// within what the cell can do.
+  std::vector<SimRunaway> runaways() const;
+  /// The fastest any tube body moved since construction (the settling included).
+  SimPeakSpeeds peak_speeds() const;
 
  private:
   struct Impl;

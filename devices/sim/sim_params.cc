@@ -161,6 +161,7 @@ void SimCellParams::Validate() const {
   Require(s.ft_window > 0.0 && s.ft_window <= 10.0, "physics.ft_window", s.ft_window, "in (0, 10] s");
   Require(s.wall_thickness > 0.0 && s.wall_thickness <= 1.0, "physics.wall_thickness", s.wall_thickness,
           "in (0, 1] m");
+  Require(s.runaway_speed > 0.0, "physics.runaway_speed", s.runaway_speed, "> 0 m/s");
 }
 
 }  // namespace tubepick::devices::sim

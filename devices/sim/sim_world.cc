@@ -102,6 +102,7 @@ SimWorld::SimWorld(const SimCellParams& params, const std::vector<physics::TubeG
     tubes_.push_back(AddSimTube(*world_, tubes_Bin[i], i, options));
   }
   carried_off_.assign(tubes_.size(), false);
+  ran_away_.assign(tubes_.size(), false);
 
   // The gripper: kinematic bodies (moved pose by pose; they push tubes with infinite mass).
   const SimGripperParams& g = params_.gripper;
@@ -211,10 +212,30 @@ void SimWorld::Step() {
   PlaceGripperBodies();
   world_->world->stepSimulation(substep_, 0);
   time_ += substep_;
+  WatchSpeeds();
   last_wrench_ = MeasureWrench();
   window_sum_.force += last_wrench_.force;
   window_sum_.torque += last_wrench_.torque;
   ++window_steps_;
+}
+
+void SimWorld::WatchSpeeds() {
+  const SimPhysicsParams& limit = params_.physics;
+  for (std::size_t i = 0; i < tubes_.size(); ++i) {
+    if (carried_off_[i]) continue;
+    double speed = 0.0;
+    double angular_speed = 0.0;
+    for (const SimLink& link : tubes_[i].links) {
+      if (!link.body->isActive()) continue;  // asleep: at rest
+      speed = std::max(speed, static_cast<double>(link.body->getLinearVelocity().length()));
+      angular_speed = std::max(angular_speed, static_cast<double>(link.body->getAngularVelocity().length()));
+    }
+    peak_speeds_.linear = std::max(peak_speeds_.linear, speed);
+    peak_speeds_.angular = std::max(peak_speeds_.angular, angular_speed);
+    if (ran_away_[i] || speed <= limit.runaway_speed) continue;
+    ran_away_[i] = true;
+    runaways_.push_back({i, time_, speed, angular_speed});
+  }
 }
 
 void SimWorld::ControlStep() {

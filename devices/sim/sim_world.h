@@ -102,6 +102,9 @@ class SimWorld {
   /// bodies and joints leave the Bullet world, its pose and index stay. Returns how many.
   std::uint32_t CarryOff(const std::function<bool(const Eigen::Vector3d&)>& where);
   bool carried_off(std::size_t i) const { return carried_off_.at(i); }
+  /// Tubes that ran away so far (SimRunaway, with `seconds` the world's time()).
+  const std::vector<SimRunaway>& runaways() const { return runaways_; }
+  const SimPeakSpeeds& peak_speeds() const { return peak_speeds_; }
   Eigen::Vector3d TubeCentreOfMass(std::size_t i) const { return CentreOfMass(tubes_.at(i)); }
 
  private:
@@ -113,6 +116,8 @@ class SimWorld {
 
   void PlaceGripperBodies();
   Wrench MeasureWrench() const;
+  /// Updates peak_speeds_ and records each tube's first runaway step.
+  void WatchSpeeds();
   btRigidBody& LinkBody(const LinkId& id) const { return *tubes_.at(id.first).links.at(id.second).body; }
   /// 0 / 1 for a pad, 2 for the hand, −1 otherwise.
   int GripperPart(const btCollisionObject* object) const;
@@ -134,6 +139,9 @@ class SimWorld {
   Wrench last_wrench_;
   Wrench window_sum_;
   int window_steps_ = 0;
+  SimPeakSpeeds peak_speeds_;
+  std::vector<SimRunaway> runaways_;
+  std::vector<bool> ran_away_;
 };
 
 }  // namespace tubepick::devices::sim

@@ -182,6 +182,17 @@ void WriteJson(const std::string& path, const json& document) {
   throw CLI::RuntimeError(128 + stop.signal());
 }
 
+/// The tubes the simulation threw (SimRoundResult::runaways), ground-truth ids 1..N.
+json RunawaysJson(const std::vector<devices::sim::SimRunaway>& runaways) {
+  json out = json::array();
+  for (const devices::sim::SimRunaway& r : runaways)
+    out.push_back({{"tube", r.tube + 1},
+                   {"seconds", r.seconds},
+                   {"speed", r.speed},
+                   {"angular_speed", r.angular_speed}});
+  return out;
+}
+
 json RoundJson(std::uint32_t round, const cell::CellRunResult& result, double wall) {
   return {{"round", round},
           {"reason", cell::ToString(result.reason)},
@@ -352,10 +363,11 @@ void Run(const CellOptions& o) {
     fmt::print(
         "round {:>2} (seed {}): {} | {} picked, {} left in the bin, {} lost in transit, {} released "
         "outside, {}"
-        "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall{}\n",
+        "{} attempts, {} scans, {:.0f} s simulated, {:.0f} s wall{}{}\n",
         round, o.seed + round, result.message, result.picks, left, result.lost, r.tubes_elsewhere,
         r.tubes_unnoticed > 0 ? fmt::format("{} carried out unnoticed, ", r.tubes_unnoticed) : "",
-        result.attempts, result.scans, r.simulated_s, wall, cell::DescribeRoundWarnings(result));
+        result.attempts, result.scans, r.simulated_s, wall, cell::DescribeRoundWarnings(result),
+        DescribeRunaways(r.runaways));
     std::fflush(stdout);
     json round_json = RoundJson(round, result, wall);
     round_json.update({{"seed", o.seed + round},
@@ -363,7 +375,10 @@ void Run(const CellOptions& o) {
                        {"released_outside", r.tubes_elsewhere},
                        {"carried_out_unnoticed", r.tubes_unnoticed},
                        {"still_held", r.tubes_held},
-                       {"simulated_s", r.simulated_s}});
+                       {"simulated_s", r.simulated_s},
+                       {"simulation_runaways", RunawaysJson(r.runaways)},
+                       {"peak_tube_speed", r.peak_speeds.linear},
+                       {"peak_tube_angular_speed", r.peak_speeds.angular}});
     rounds_json.push_back(std::move(round_json));
     if (result.reason == cell::CellStopReason::kFault) {
       any_fault = true;

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <optional>
 
+#include <fmt/core.h>
+
 #include "clients/cli/inputs/sim_scene.h"
 #include "physics/random_tubes.h"
 
@@ -48,11 +50,13 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& 
                                   sim.cell(), params, sink);
   controller.set_device_clock([&sim] { return sim.SimulatedSeconds(); });
   controller.set_annotator([&sim] {
-    return nlohmann::json{{"tubes_in_bin", sim.TubesInBin()},
-                          {"tubes_outside_bin", sim.TubesOutsideBin()},
-                          {"tubes_elsewhere", sim.TubesElsewhere()},
-                          {"held", sim.HeldTubes().size()},
-                          {"sim_seconds", sim.SimulatedSeconds()}};
+    nlohmann::json truth{{"tubes_in_bin", sim.TubesInBin()},
+                         {"tubes_outside_bin", sim.TubesOutsideBin()},
+                         {"tubes_elsewhere", sim.TubesElsewhere()},
+                         {"held", sim.HeldTubes().size()},
+                         {"sim_seconds", sim.SimulatedSeconds()}};
+    if (const std::size_t thrown = sim.runaways().size(); thrown > 0) truth["runaways"] = thrown;
+    return truth;
   });
   if (observer) controller.set_state_observer(std::move(observer));
   SimRoundResult result;
@@ -72,8 +76,24 @@ SimRoundResult RunSimRound(cell::PlannerClient& planner, devices::sim::SimCell& 
   const std::uint32_t known = result.run.picks + result.run.lost;
   result.tubes_unnoticed = result.tubes_in_place_zone > known ? result.tubes_in_place_zone - known : 0;
   result.simulated_s = sim.SimulatedSeconds();
+  result.runaways = sim.runaways();
+  result.peak_speeds = sim.peak_speeds();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;
+}
+
+std::string DescribeRunaways(const std::vector<devices::sim::SimRunaway>& runaways) {
+  if (runaways.empty()) return "";
+  std::string out = fmt::format(
+      "; the simulation threw {} tube{} (a blow-up: where {} went is the simulator's "
+      "doing, not the controller's):",
+      runaways.size(), runaways.size() == 1 ? "" : "s", runaways.size() == 1 ? "it" : "they");
+  for (std::size_t k = 0; k < runaways.size(); ++k) {
+    const devices::sim::SimRunaway& r = runaways[k];
+    out += fmt::format("{} tube {} at {:.1f} m/s, {:.0f} rad/s, {:.1f} s", k == 0 ? "" : ",", r.tube + 1,
+                       r.speed, r.angular_speed, r.seconds);
+  }
+  return out;
 }
 
 }  // namespace tubepick::cli

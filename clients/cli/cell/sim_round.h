@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "clients/cell/cell_controller.h"
 #include "clients/cell/cell_records.h"
@@ -35,7 +36,16 @@ struct SimRoundResult {
   /// Simulated seconds of the round and the wall time it took (cell construction included).
   double simulated_s = 0.0;
   double wall_s = 0.0;
+  /// Tubes the simulation threw (devices::sim::SimRunaway): where they ended is not the controller's
+  /// doing. Empty in a round the simulation kept within what the cell can do.
+  std::vector<devices::sim::SimRunaway> runaways;
+  /// The fastest any tube body moved in the round (its bin's settling included).
+  devices::sim::SimPeakSpeeds peak_speeds;
 };
+
+/// "" without runaways, else a clause for the round's line naming each thrown tube (ground-truth id,
+/// simulated time, speeds) and that where it went is the simulator's doing.
+std::string DescribeRunaways(const std::vector<devices::sim::SimRunaway>& runaways);
 
 /// Builds a SimCell from `sim_params`, runs the cell controller on it against `planner` until the
 /// bin is empty, a limit or a fault, and returns what happened. The controller sees the cell of

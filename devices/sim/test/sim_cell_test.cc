@@ -684,5 +684,35 @@ TEST(SimCell, SameParamsSameCell) {
   EXPECT_NE(PickTopTube(params).centres, a.centres);
 }
 
+TEST(SimCell, ATubeFasterThanTheCellCanMoveOneIsARunaway) {
+  // A tube 0.3 m above the floor falls while the bin settles: 2.4 m/s at the floor (√(2·g·0.3)).
+  SimCellParams params;
+  const double r = params.cell.tube.radius;
+  const auto falling = [r] {
+    physics::TubeGeometry tube = StraightTube(1, r, 0.5);
+    for (auto& node : tube.nodes) node.centre.z() += 0.3;
+    return tube;
+  };
+  {
+    const SimCell cell(params, {falling()});
+    EXPECT_TRUE(cell.runaways().empty());  // within the default 6 m/s
+    EXPECT_NEAR(cell.peak_speeds().linear, std::sqrt(2.0 * kG * 0.3), 0.15);
+  }
+  params.physics.runaway_speed = 1.5;
+  const SimCell cell(params, {falling()});
+  ASSERT_EQ(cell.runaways().size(), 1u);  // once, though faster than 1.5 m/s for many steps
+  const SimRunaway thrown = cell.runaways().front();
+  EXPECT_EQ(thrown.tube, 0u);
+  EXPECT_GT(thrown.speed, 1.5);
+  EXPECT_LT(thrown.speed, 1.6);    // the first step past the limit
+  EXPECT_LT(thrown.seconds, 0.0);  // while the bin settled, before the cell's clock starts
+  EXPECT_THROW(
+      {
+        params.physics.runaway_speed = 0.0;
+        SimCell bad(params, {falling()});
+      },
+      InvalidArgument);
+}
+
 }  // namespace
 }  // namespace tubepick::devices::sim
