@@ -28,13 +28,20 @@ const char* ResultName(int result) {
   return kNames[result];
 }
 
-/// What the attempts since the last pick came to, the most recent eight at most.
+/// What the attempts since the last pick came to, the most recent eight at most; a run of the same
+/// outcome is one entry, "N × outcome".
 std::string AttemptsSincePick(const std::vector<std::string>& since_pick) {
   constexpr std::size_t kShown = 8;
-  const std::size_t n = since_pick.size();
-  if (n <= kShown) return fmt::format("{}", fmt::join(since_pick, ", "));
-  return fmt::format("{} earlier, then {}", n - kShown,
-                     fmt::join(since_pick.end() - kShown, since_pick.end(), ", "));
+  std::vector<std::string> runs;
+  for (std::size_t i = 0; i < since_pick.size();) {
+    std::size_t j = i + 1;
+    while (j < since_pick.size() && since_pick[j] == since_pick[i]) ++j;
+    runs.push_back(j - i == 1 ? since_pick[i] : fmt::format("{} × {}", j - i, since_pick[i]));
+    i = j;
+  }
+  const std::size_t n = runs.size();
+  if (n <= kShown) return fmt::format("{}", fmt::join(runs, ", "));
+  return fmt::format("{} earlier, then {}", n - kShown, fmt::join(runs.end() - kShown, runs.end(), ", "));
 }
 
 }  // namespace
