@@ -141,26 +141,16 @@ std::optional<double> ClearPush(const std::array<ToolBox, 3>& boxes, const Eigen
   return distance;
 }
 
-}  // namespace
+// A tube along a wall, nudged in this order: non-occluded first, then closest to a wall.
+struct Candidate {
+  int index;
+  bool occluded;
+  double wall_distance;
+};
 
-std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan) {
-  const Eigen::Vector3d push = plan.distance * plan.direction;
-  return {Eigen::Vector3d::Zero(), push};
-}
-
-std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
-                                   const CellConfig& cell, const ToolGeometry& tool,
-                                   const NudgeParams& params, double lift, double transit_z,
-                                   std::uint32_t try_index) {
-  static constexpr std::array<double, 3> kFractions = {0.5, 0.3, 0.7};
-  const double fraction = kFractions[try_index % kFractions.size()];
-
-  // Tubes along a wall: non-occluded first, then closest to a wall.
-  struct Candidate {
-    int index;
-    bool occluded;
-    double wall_distance;
-  };
+// The tubes with an axis sample closer than params.near_wall_distance to a wall, in nudge order.
+std::vector<Candidate> WallTubes(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
+                                 const CellConfig& cell, const NudgeParams& params) {
   std::vector<Candidate> candidates;
   for (int i = 0; i < tubes.size(); ++i) {
     double nearest = std::numeric_limits<double>::infinity();
@@ -177,12 +167,99 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
     if (a.occluded != b.occluded) return !a.occluded;
     return a.wall_distance < b.wall_distance;
   });
+  return candidates;
+}
 
-  const std::array<ToolBox, 3> closed_tool = ToolBoxes(tool, 0.0);
+// The push at axis sample `s`: away from every wall closer than params.near_wall_distance, by the push
+// gain's distance; nullopt when no wall is that close. The press pose is PlacePress's.
+std::optional<NudgePlan> PushAt(const Sample& s, int tube_id, const CellConfig& cell,
+                                const NudgeParams& params) {
+  const Walls w = WallDistances(s.p_Bin, cell);
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    if (w.distance[k] < params.near_wall_distance) direction += Walls::Inward(k);
+    nearest = std::min(nearest, w.distance[k]);
+  }
+  if (direction.norm() < 1e-9) return std::nullopt;
+  NudgePlan plan;
+  plan.tube_id = tube_id;
+  plan.p_Bin_contact = s.p_Bin;
+  plan.wall_distance = nearest;
+  plan.direction = direction.normalized();
+  plan.distance = std::clamp(params.push_gain * (params.target_wall_distance - nearest), params.min_push,
+                             params.max_push);
+  return plan;
+}
+
+// What PlacePress needs besides the contact: the cell, the tool and its closed boxes, the rise after the
+// push and the transit height the tool comes down from.
+struct NudgeTools {
+  const CellConfig& cell;
+  const ToolGeometry& tool;
+  const NudgeParams& params;
+  std::array<ToolBox, 3> closed_tool;
+  double lift;
+  double transit_z;
+};
+
+// Places the closed pads on `s` for `plan`'s push: housing's narrow side to the wall, tilted by params.tilt,
+// shifted up to half a pad along the push until the tool clears the bin (ToolClearanceProblem) and the
+// tubes (ClearPush) on its whole way; fills plan.X_BinTcpPress, shift and the clear distance. False when
+// no shift does.
+bool PlacePress(const Sample& s, const NudgeTools& t, const Obstacles& obstacles, NudgePlan& plan) {
+  const NudgeParams& params = t.params;
+  const Eigen::Vector3d& direction = plan.direction;
+  // z_Tcp down, x_Tcp along the push: the housing's narrow side faces the wall.
+  Eigen::Matrix3d R_BinTcp;
+  R_BinTcp.col(0) = direction;
+  R_BinTcp.col(2) = -Eigen::Vector3d::UnitZ();
+  R_BinTcp.col(1) = R_BinTcp.col(2).cross(R_BinTcp.col(0));
+  R_BinTcp = R_BinTcp * Eigen::AngleAxisd(-params.tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const double pad_bottom = s.p_Bin.z() + s.radius - params.press_depth;
+  // The pads (tool.finger_size.x along the push) must still cover the tube's top.
+  const double max_shift = 0.5 * t.tool.finger_size.x() + 0.5 * s.radius;
+  const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
+                                             plan.distance * direction + Eigen::Vector3d(0, 0, t.lift)};
+  for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
+    Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
+    X_BinTcpPress.linear() = R_BinTcp;
+    // The pads' bottom centre (tool.finger_tip_depth along z_Tcp) on the contact point.
+    Eigen::Vector3d p_Bin_tip = s.p_Bin + shift * direction;
+    p_Bin_tip.z() = pad_bottom;
+    X_BinTcpPress.translation() = p_Bin_tip - t.tool.finger_tip_depth * R_BinTcp.col(2);
+    if (ToolClearanceProblem(t.cell, t.tool, X_BinTcpPress, 0.0, path)) continue;
+    // The closed tool comes down from the transit height and goes back up to it.
+    const double rise = std::max(t.lift, t.transit_z - X_BinTcpPress.translation().z());
+    const std::optional<double> push = ClearPush(t.closed_tool, X_BinTcpPress, direction, plan.distance,
+                                                 params.min_push, rise, obstacles, params.tube_clearance);
+    if (!push) continue;
+    plan.distance = *push;
+    plan.shift = shift;
+    plan.X_BinTcpPress = X_BinTcpPress;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> NudgePushWaypoints(const NudgePlan& plan) {
+  const Eigen::Vector3d push = plan.distance * plan.direction;
+  return {Eigen::Vector3d::Zero(), push};
+}
+
+std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::Tube>& tubes,
+                                   const CellConfig& cell, const ToolGeometry& tool,
+                                   const NudgeParams& params, double lift, double transit_z,
+                                   std::uint32_t try_index) {
+  static constexpr std::array<double, 3> kFractions = {0.5, 0.3, 0.7};
+  const double fraction = kFractions[try_index % kFractions.size()];
+  const NudgeTools tools{cell, tool, params, ToolBoxes(tool, 0.0), lift, transit_z};
   // Obstacle samples spaced at most one growth of the slab test apart (FirstContact).
   const double obstacle_spacing =
       std::min(params.sample_spacing, params.tube_clearance + 0.5 * cell.tube.radius);
-  for (const Candidate& candidate : candidates) {
+  for (const Candidate& candidate : WallTubes(tubes, cell, params)) {
     const v1::Tube& tube = tubes[candidate.index];
     const std::vector<Sample> others = OtherTubes(tubes, candidate.index, obstacle_spacing, cell.tube.radius);
     const std::vector<Sample> own = SampleTube(tube, obstacle_spacing, cell.tube.radius);
@@ -192,54 +269,10 @@ std::optional<NudgePlan> PlanNudge(const google::protobuf::RepeatedPtrField<v1::
       return std::abs(a.fraction - fraction) < std::abs(b.fraction - fraction);
     });
     for (const Sample& s : samples) {
-      const Walls w = WallDistances(s.p_Bin, cell);
-      Eigen::Vector3d direction = Eigen::Vector3d::Zero();
-      double nearest = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < 4; ++k) {
-        if (w.distance[k] < params.near_wall_distance) direction += Walls::Inward(k);
-        nearest = std::min(nearest, w.distance[k]);
-      }
-      if (direction.norm() < 1e-9) continue;
-      direction.normalize();
-
-      NudgePlan plan;
-      plan.tube_id = tube.id();
-      plan.p_Bin_contact = s.p_Bin;
-      plan.wall_distance = nearest;
-      plan.direction = direction;
-      plan.distance = std::clamp(params.push_gain * (params.target_wall_distance - nearest), params.min_push,
-                                 params.max_push);
-      // z_Tcp down, x_Tcp along the push: the housing's narrow side faces the wall.
-      Eigen::Matrix3d R_BinTcp;
-      R_BinTcp.col(0) = direction;
-      R_BinTcp.col(2) = -Eigen::Vector3d::UnitZ();
-      R_BinTcp.col(1) = R_BinTcp.col(2).cross(R_BinTcp.col(0));
-      R_BinTcp = R_BinTcp * Eigen::AngleAxisd(-params.tilt, Eigen::Vector3d::UnitY()).toRotationMatrix();
-      const double pad_bottom = s.p_Bin.z() + s.radius - params.press_depth;
-      // The pads (tool.finger_size.x along the push) must still cover the tube's top.
-      const double max_shift = 0.5 * tool.finger_size.x() + 0.5 * s.radius;
-      const std::vector<Eigen::Vector3d> path = {Eigen::Vector3d::Zero(), plan.distance * direction,
-                                                 plan.distance * direction + Eigen::Vector3d(0, 0, lift)};
+      std::optional<NudgePlan> plan = PushAt(s, tube.id(), cell, params);
+      if (!plan) continue;
       const std::vector<Sample> own_above = OwnAbove(own, s);
-      const Obstacles obstacles{others, own_above};
-      for (double shift = 0.0; shift <= max_shift + 1e-9; shift += 0.002) {
-        Eigen::Isometry3d X_BinTcpPress = Eigen::Isometry3d::Identity();
-        X_BinTcpPress.linear() = R_BinTcp;
-        // The pads' bottom centre (tool.finger_tip_depth along z_Tcp) on the contact point.
-        Eigen::Vector3d p_Bin_tip = s.p_Bin + shift * direction;
-        p_Bin_tip.z() = pad_bottom;
-        X_BinTcpPress.translation() = p_Bin_tip - tool.finger_tip_depth * R_BinTcp.col(2);
-        if (ToolClearanceProblem(cell, tool, X_BinTcpPress, 0.0, path)) continue;
-        // The closed tool comes down from the transit height and goes back up to it.
-        const double rise = std::max(lift, transit_z - X_BinTcpPress.translation().z());
-        const std::optional<double> push = ClearPush(closed_tool, X_BinTcpPress, direction, plan.distance,
-                                                     params.min_push, rise, obstacles, params.tube_clearance);
-        if (!push) continue;
-        plan.distance = *push;
-        plan.shift = shift;
-        plan.X_BinTcpPress = X_BinTcpPress;
-        return plan;
-      }
+      if (PlacePress(s, tools, Obstacles{others, own_above}, *plan)) return plan;
     }
   }
   return std::nullopt;

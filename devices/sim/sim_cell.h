@@ -161,9 +161,9 @@ struct SimPhysicsParams {
 };
 
 /// A tube that moved faster than anything in the cell can move it (SimPhysicsParams::runaway_speed):
-/// the solver put energy into it (a blow-up of the simulation, e.g. rigid
-/// trees locked into each other), and where it goes next is the simulator's doing, not the cell's.
-/// The first such step of each tube.
+/// the solver put energy into it (a blow-up of the simulation, e.g. rigid trees locked into each
+/// other), and where it goes next is the simulator's doing, not the cell's. The first such step of
+/// each tube.
 struct SimRunaway {
   /// Index into SimCell::TubesBin.
   std::size_t tube = 0;

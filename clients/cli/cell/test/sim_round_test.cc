@@ -9,7 +9,7 @@ namespace {
 TEST(SimRound, ARoundWithoutRunawaysSaysNothingOfThem) { EXPECT_EQ(DescribeRunaways({}), ""); }
 
 TEST(SimRound, ThrownTubesAreNamedByGroundTruthIdWithTheirTimeAndSpeeds) {
-  // Seed 14 of the 20-pvc-tree bins: two trees thrown during a resolution rotation.
+  // Seed 14 of the 20-pvc-tree bins: two trees thrown just after a resolution rotation had freed them.
   const std::vector<devices::sim::SimRunaway> thrown = {
       {.tube = 16, .seconds = 315.79, .speed = 6.04, .angular_speed = 41.1},
       {.tube = 13, .seconds = 315.87, .speed = 6.9, .angular_speed = 40.5}};
