@@ -25,13 +25,15 @@ void FaultCampaign::Add(const SimRoundResult& round, const FaultInjector* inject
   lost_in_transit += run.lost;
   local_analyses += run.local_analyses;
   if (run.reason == cell::CellStopReason::kBinEmpty && round.tubes_in_bin == 0) ++bins_emptied;
+  thrown_by_simulation += static_cast<std::uint32_t>(round.runaways.size());
 }
 
 std::string FaultCampaign::SummaryLine() const {
   return fmt::format(
-      "faults: injected={} safe_stops={} released_outside={} lost_in_transit={} bins_emptied={}/{}{}",
+      "faults: injected={} safe_stops={} released_outside={} lost_in_transit={} bins_emptied={}/{}{}{}",
       injected, safe_stops, released_outside, lost_in_transit, bins_emptied, rounds,
-      carried_out_unnoticed > 0 ? fmt::format(" carried_out_unnoticed={}", carried_out_unnoticed) : "");
+      carried_out_unnoticed > 0 ? fmt::format(" carried_out_unnoticed={}", carried_out_unnoticed) : "",
+      thrown_by_simulation > 0 ? fmt::format(" thrown_by_simulation={}", thrown_by_simulation) : "");
 }
 
 std::string FaultCampaign::KindsLine() const {
@@ -60,7 +62,8 @@ nlohmann::json FaultCampaign::Json(double rate, std::uint64_t seed) const {
           {"carried_out_unnoticed", carried_out_unnoticed},
           {"lost_in_transit", lost_in_transit},
           {"local_analyses", local_analyses},
-          {"bins_emptied", bins_emptied}};
+          {"bins_emptied", bins_emptied},
+          {"thrown_by_simulation", thrown_by_simulation}};
 }
 
 }  // namespace tubepick::cli

@@ -33,11 +33,14 @@ struct FaultCampaign {
   std::uint32_t local_analyses = 0;
   /// Rounds that ended with the bin reported empty and no tube left in it.
   std::uint32_t bins_emptied = 0;
+  /// Tubes the simulation threw (SimRoundResult::runaways): released_outside may count them, but
+  /// where they went is the simulator's doing, not a fault path's.
+  std::uint32_t thrown_by_simulation = 0;
 
   /// Adds one round (`injector` null: no faults were injected in it).
   void Add(const SimRoundResult& round, const FaultInjector* injector);
   /// "faults: injected=I safe_stops=S released_outside=R lost_in_transit=L bins_emptied=E/N"
-  /// (and " carried_out_unnoticed=U" when U > 0).
+  /// (and " carried_out_unnoticed=U", " thrown_by_simulation=T" when they are not 0).
   std::string SummaryLine() const;
   /// "faults by kind: robot_alarm=…, slip=…; safe stops holding a tube: …".
   std::string KindsLine() const;
