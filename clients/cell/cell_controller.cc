@@ -126,6 +126,14 @@ std::string DescribeTubeMassDoubt(const CellRunResult& result) {
 std::string DescribeVanishedOverWalls(const CellRunResult& result) {
   const std::size_t n = result.vanished_over_walls.size();
   if (n == 0) return "";
+  // The bin found empty with every one of its tubes_per_bin tubes placed: none of them is on the floor
+  // (a tree leaning on a wall slides back in when what it leaned on is picked, and is picked later).
+  if (result.tubes_expected > 0 && result.picks == result.tubes_expected)
+    return fmt::format(
+        "; {} hanging over a wall {} not seen there again, but every tube of the bin was placed ({} of "
+        "tubes_per_bin {}), so {} not fall out: {}",
+        Count(static_cast<std::uint32_t>(n), "tube"), n == 1 ? "was" : "were", result.picks,
+        result.tubes_expected, n == 1 ? "it did" : "they did", fmt::join(result.vanished_over_walls, "; "));
   return fmt::format("; {} hanging over a wall {} not seen again, {} have fallen out of the bin: {}",
                      Count(static_cast<std::uint32_t>(n), "tube"), n == 1 ? "was" : "were",
                      n == 1 ? "it may" : "they may", fmt::join(result.vanished_over_walls, "; "));
@@ -304,6 +312,8 @@ void CellController::CountTubes(CellRunResult& result) const {
   // The round line's words ("; 2 of the bin's 20 tubes ...", or "" when the count is met).
   const std::string said = DescribeTubeCount(result);
   if (!said.empty()) spdlog::warn("cell: round {}: bin empty: {}", round_, said.substr(2));
+  if (!result.vanished_over_walls.empty() && result.picks == result.tubes_expected)
+    spdlog::info("cell: round {}: bin empty: {}", round_, DescribeVanishedOverWalls(result).substr(2));
 }
 
 // ---------------------------------------------------------------- scan, plan

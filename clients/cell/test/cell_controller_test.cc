@@ -1949,6 +1949,33 @@ TEST_F(WallWatchTest, ATubeOverAWallThatTheNextScanNoLongerShowsIsNamedOnTheRoun
   EXPECT_EQ(attempts[1]["vanished_over_walls"].size(), 1u);
 }
 
+TEST_F(WallWatchTest, ATubeGoneFromOverAWallIsAccountedForWhenEveryTubeOfTheBinWasPlaced) {
+  // As above (one tube placed: the second scan's plan fails the cell check): in a bin of one tube
+  // (tubes_per_bin), the one gone from over the wall was that tube, placed; in a bin of two, one is
+  // missing and the warning stands.
+  params.tubes_per_bin = 1;
+  ScriptATubeOverAWallThenAnotherScan();
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  const CellRunResult placed = Run();
+  EXPECT_EQ(placed.picks, 1u);
+  ASSERT_EQ(placed.vanished_over_walls.size(), 1u);
+  EXPECT_EQ(
+      DescribeRoundWarnings(placed),
+      "; 1 tube hanging over a wall was not seen there again, but every tube of the bin was placed (1 of "
+      "tubes_per_bin 1), so it did not fall out: over the -y wall at (-0.029, -0.304, 0.220) m, not seen "
+      "again after scan 0");
+
+  params.tubes_per_bin = 2;
+  ScriptATubeOverAWallThenAnotherScan();
+  planner.wrench_answers = {Outcome(v1::HELD_OUTCOME_SINGLE, 1.0), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+  const CellRunResult missing = Run();
+  EXPECT_THAT(
+      DescribeRoundWarnings(missing),
+      ::testing::HasSubstr("; 1 tube hanging over a wall was not seen again, it may have fallen out of the "
+                           "bin: over the -y wall"));
+  EXPECT_THAT(DescribeRoundWarnings(missing), ::testing::HasSubstr("1 of the bin's 2 tubes unaccounted for"));
+}
+
 TEST_F(WallWatchTest, ATubeOverAWallThatTheNextCloudStillShowsIsNotMissedThoughTheModelDropsIt) {
   // The tube over the wall is still in every capture; scan 1's model lost it.
   for (int i = 0; i < 30; ++i) scanner.points_Bin.push_back({-0.04 + 0.001 * i, -0.295, 0.225});
