@@ -33,15 +33,19 @@ const char* ResultName(int result) {
 std::string AttemptsSincePick(const std::vector<std::string>& since_pick) {
   constexpr std::size_t kShown = 8;
   std::vector<std::string> runs;
+  std::vector<std::size_t> run_begin;  // index into since_pick of each run's first outcome
   for (std::size_t i = 0; i < since_pick.size();) {
     std::size_t j = i + 1;
     while (j < since_pick.size() && since_pick[j] == since_pick[i]) ++j;
     runs.push_back(j - i == 1 ? since_pick[i] : fmt::format("{} × {}", j - i, since_pick[i]));
+    run_begin.push_back(i);
     i = j;
   }
   const std::size_t n = runs.size();
   if (n <= kShown) return fmt::format("{}", fmt::join(runs, ", "));
-  return fmt::format("{} earlier, then {}", n - kShown, fmt::join(runs.end() - kShown, runs.end(), ", "));
+  // "N earlier": the attempts and scans before the runs shown.
+  return fmt::format("{} earlier, then {}", run_begin[n - kShown],
+                     fmt::join(runs.end() - kShown, runs.end(), ", "));
 }
 
 }  // namespace

@@ -886,20 +886,21 @@ TEST_F(CellControllerTest, AnAttemptLimitSaysWhatEachLiftSinceTheLastPickWeighed
 }
 
 TEST_F(CellControllerTest, AnAttemptLimitListsTheLastEightAttempts) {
-  // Ten failures since the last pick, a failed grasp and a scan without plan in turn: ten entries,
-  // the last eight shown.
+  // Eleven failures since the last pick: two scans without plan, then a failed grasp and a scan without
+  // plan in turn: ten entries, the last eight shown, the three failures before them counted.
   params.max_attempts_per_tube = 20;
-  params.max_consecutive_failures = 10;
+  params.max_consecutive_failures = 11;
   params.max_plans_per_scan = 1;
+  planner.plan_answers.push_back(Plans({}, 2));
   for (int i = 0; i < 5; ++i) {
-    planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 2));
     planner.plan_answers.push_back(Plans({}, 2));
+    planner.plan_answers.push_back(Plans({MakePlan(1, GraspSpot(i))}, 2));
     gripper.close_results.push_back(ClosedOnNothing());
   }
   const CellRunResult result = Run();
   EXPECT_EQ(result.attempts, 5u);
-  EXPECT_NE(result.message.find("since the last pick: 2 earlier, then grasp_failed, no plan, grasp_failed, "
-                                "no plan, grasp_failed, no plan, grasp_failed, no plan)"),
+  EXPECT_NE(result.message.find("since the last pick: 3 earlier, then no plan, grasp_failed, no plan, "
+                                "grasp_failed, no plan, grasp_failed, no plan, grasp_failed)"),
             std::string::npos)
       << result.message;
 }
