@@ -155,8 +155,8 @@ struct SimPhysicsParams {
   /// A tube body whose centre of mass moves faster than this, m/s, is a runaway (SimRunaway):
   /// nothing in the cell moves a tube that fast (the arm at most 1 m/s, a tube falling from the
   /// transit height onto the ground 3-4 m/s; the fastest body of rounds without a blow-up
-  /// 1.4-2.3 m/s, docs/ACCURACY.md). Spin is no criterion: a rubber hose's short links spin at up
-  /// to 47 rad/s in such rounds, a pvc tree at 21, the blow-up traced at 41-62.
+  /// 1.0-2.5 m/s, docs/ACCURACY.md). Spin is no criterion: a rubber hose's short links spin at up
+  /// to 110 rad/s in such rounds, a pvc tree at 21, the blow-up traced at 41-62.
   double runaway_speed = 6.0;
 };
 
