@@ -152,6 +152,8 @@ void DescribeFields(Visit& v, JunctionCompletionParams& p) {
   v("enabled", p.enabled, "false: ends left after the nodes and links are not tried again");
   v("max_gap", p.max_gap, "as max_gap and side_max_gap, for the ends tried again, m");
   v("max_axis_offset", p.max_axis_offset, "as max_axis_offset and side_max_axis_offset, for them, m");
+  v("facing_offset_mean", p.facing_offset_mean,
+    "two ends facing across a gap: offset = mean of each from the other's axis (false: the second's)");
   v("max_length_share", p.max_length_share, "no tree they make longer than this share of tube.length");
 }
 

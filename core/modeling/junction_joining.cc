@@ -89,9 +89,11 @@ double RoomReach(const EndRooms& rooms, std::uint32_t chain, bool at_end, double
 // max_gap, pass within max_axis_offset of each other at an angle of at least min_angle, or that
 // face each other along one line within that reach (a run broken at a T-piece's node; alone,
 // such a pair is the linear joining's business, so only a third end makes it a node). Ends
-// pointing the same way side by side never meet. Cheapest first.
+// pointing the same way side by side never meet. Cheapest first. A facing pair's offset is the
+// second end's distance from the first end's axis, or with `facing_offset_mean` the mean of each
+// end's distance from the other's axis (JunctionCompletionParams::facing_offset_mean).
 std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const JunctionParams& params,
-                                        const EndRooms& rooms) {
+                                        const EndRooms& rooms, bool facing_offset_mean = false) {
   const double cos_min = std::cos(params.min_angle);
   struct End {
     std::pair<std::uint32_t, bool> id;
@@ -127,7 +129,9 @@ std::vector<EndMeeting> FindEndMeetings(const std::vector<Tube>& chains, const J
         // which only a third end meeting them turns into a node). They meet halfway.
         const Eigen::Vector3d gap = y.end.p - x.end.p;
         const double along = gap.dot(x.end.out);
-        const double offset = (gap - along * x.end.out).norm();
+        const double off_x = (gap - along * x.end.out).norm();
+        const double off_y = (gap + gap.dot(-y.end.out) * y.end.out).norm();
+        const double offset = facing_offset_mean ? 0.5 * (off_x + off_y) : off_x;
         if (along <= 0.0 || along > x.reach + y.reach || offset > params.max_axis_offset) continue;
         out.push_back({x.id, y.id, 0.5 * (x.end.p + y.end.p), along + offset, linkable(x, y)});
         continue;
@@ -365,7 +369,7 @@ JunctionJoining JoinJunctionsWithin(const std::vector<Tube>& chains, const Junct
     wide.max_gap = wide.side_max_gap = params.completion.max_gap;
     wide.max_axis_offset = wide.side_max_axis_offset = params.completion.max_axis_offset;
     completion.sides = FindJunctions(chains, wide, shape, rooms);
-    completion.pairs = FindEndMeetings(chains, wide, rooms);
+    completion.pairs = FindEndMeetings(chains, wide, rooms, params.completion.facing_offset_mean);
   }
   Accepted accepted = Accept(chains, ClusterMeetings(FindEndMeetings(chains, params, rooms), params),
                              FindJunctions(chains, params, shape, rooms), completion, max_tree_length,

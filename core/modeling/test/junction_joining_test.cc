@@ -284,7 +284,7 @@ TEST(JunctionJoining, TwoArmsOfAYWhoseThirdIsHiddenAreLinkedAcrossAWideKink) {
 TEST(JunctionJoining, TheThirdArmOfALinkedPairJoinsTheirNodeInTheCompletion) {
   // Two arms linked across a 130° kink at `node` (as above) and a third arm whose end lies 9 cm
   // from the node, pointing at it: past a Y-piece's reach (radius + 5 cm), within the
-  // completion's (radius + 8 cm). The completion pairs it with an end the link already took.
+  // completion's (radius + 10 cm). The completion pairs it with an end the link already took.
   const Eigen::Vector3d node(0, 0, kR);
   const std::vector<Tube> chains = {Chain({Cyl(node + 0.30 * Dir(180), node + 0.025 * Dir(180), 0)}),
                                     Chain({Cyl(node + 0.025 * Dir(130), node + 0.15 * Dir(130), 1)}),
@@ -310,6 +310,44 @@ TEST(JunctionJoining, TheThirdArmOfALinkedPairJoinsTheirNodeInTheCompletion) {
   // Within the tube length only: 0.275 + 0.125 + 0.10 + the links (0.025 + 0.025 + 0.09), 0.64 m.
   EXPECT_EQ(join(0.62).tubes.size(), 2u);
   EXPECT_EQ(join(0.66).tubes.size(), 1u);
+}
+
+TEST(JunctionJoining, TwoEndsFacingAcrossAHiddenGapAreJudgedFromBothEnds) {
+  // A run ends at the origin pointing along x; the other part of it goes on 9.5 cm further and
+  // 2.4 cm aside (a bend under the tube that hides the gap), its end pointing straight back at the
+  // run's end. From the run's axis the other end is 2.4 cm off, past the completion's 2 cm; from
+  // its own axis 0: the mean, 1.2 cm, is within, whichever chain comes first.
+  const Eigen::Vector3d p_x(0, 0, kR), p_y(0.095, 0.024, kR);
+  const Eigen::Vector3d u = (p_x - p_y).normalized();
+  const Tube run = Chain({Cyl(p_x - 0.25 * Eigen::Vector3d::UnitX(), p_x, 0)});
+  const Tube other = Chain({Cyl(p_y - 0.15 * u, p_y, 1)});
+  auto join = [&](const std::vector<Tube>& chains, bool mean) {
+    JunctionParams params;
+    params.completion.facing_offset_mean = mean;
+    return JoinJunctions(chains, params, JunctionShape::kAny, nullptr, {}, 0.75);
+  };
+  for (const auto& chains : {std::vector<Tube>{run, other}, std::vector<Tube>{other, run}}) {
+    const JunctionJoining joined = join(chains, true);
+    ASSERT_EQ(joined.tubes.size(), 1u);
+    ASSERT_EQ(joined.decisions.size(), 1u);
+    EXPECT_EQ(joined.decisions[0].kind, JoinDecision::Kind::kCompletionLink);
+    EXPECT_NEAR(joined.tubes[0].length(), 0.25 + (p_y - p_x).norm() + 0.15, 1e-9);
+  }
+  // Judged from the first chain's axis only, the order decides.
+  EXPECT_EQ(join({run, other}, false).tubes.size(), 2u);
+  EXPECT_EQ(join({other, run}, false).tubes.size(), 1u);
+  // The completion's reach is the radius plus 10 cm from each end: a straight gap of 20 cm is
+  // bridged (not with 8 cm), one of 24 cm is not.
+  auto beyond = [&](double gap) {
+    const Eigen::Vector3d p = p_x + gap * Eigen::Vector3d::UnitX();
+    return Chain({Cyl(p + 0.15 * Eigen::Vector3d::UnitX(), p, 1)});
+  };
+  EXPECT_EQ(join({run, beyond(0.20)}, true).tubes.size(), 1u);
+  EXPECT_EQ(join({run, beyond(0.24)}, true).tubes.size(), 2u);
+  JunctionParams shorter;
+  shorter.completion.max_gap = 0.08;
+  EXPECT_EQ(JoinJunctions({run, beyond(0.20)}, shorter, JunctionShape::kAny, nullptr, {}, 0.75).tubes.size(),
+            2u);
 }
 
 TEST(JunctionJoining, ASecondBranchJoinsATeeNodeInTheCompletion) {
