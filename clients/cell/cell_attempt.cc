@@ -352,9 +352,10 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
 /// One tube held: transit above the place pose (the gripper's object status checked after every
 /// segment), a reading there that must still weigh a tube, down, the status once more, open, up,
 /// a reading that must weigh nothing (a hose hooked on a pad is not carried home), home.
-void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
+void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlanned, const devices::WrenchReading& reference,
                            Attempt& attempt) {
   Enter(CellState::kPlace);
+  const Eigen::Isometry3d X_BinTcpPlace = ClearOfThePlaceSurface(X_BinTcpPlanned, attempt);
   Eigen::Isometry3d X_BinTcpAbovePlace = X_BinTcpPlace;
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
   TransitTo(X_BinTcpAbovePlace, &attempt, [&] { CheckStillHolding("place_transit", attempt); });
@@ -392,6 +393,22 @@ void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices
   MoveTo(X_BinTcpAbovePlace, params_.approach_speed, &attempt);
   CheckToolEmpty(reference, "after_place", X_BinTcpPlace, attempt);
   GoHome(&attempt);
+}
+
+Eigen::Isometry3d CellController::ClearOfThePlaceSurface(const Eigen::Isometry3d& X_BinTcpPlanned,
+                                                         Attempt& attempt) const {
+  const double lowest = ToolLowestZ(params_.tool, 2.0 * cell_.tube.radius, X_BinTcpPlanned);
+  const double clear = params_.place_surface_height + params_.tool.margin;
+  if (lowest >= clear) return X_BinTcpPlanned;
+  Eigen::Isometry3d X_BinTcpPlace = X_BinTcpPlanned;
+  X_BinTcpPlace.translation().z() += clear - lowest;
+  attempt.record["place_raised"] = clear - lowest;
+  spdlog::info(
+      "cell: round {}: the planned place pose would bring the tool to z {:.3f} m, {:.3f} m from the place "
+      "surface (place_surface_height {:.3f} m, tool.margin {:.3f} m): placing {:.3f} m higher",
+      round_, lowest, lowest - params_.place_surface_height, params_.place_surface_height, params_.tool.margin,
+      clear - lowest);
+  return X_BinTcpPlace;
 }
 
 void CellController::DescendOntoPlace(const Eigen::Isometry3d& X_BinTcpPlace,

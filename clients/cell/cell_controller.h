@@ -449,6 +449,9 @@ class CellController {
                                 const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) const;
   void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
              Attempt& attempt);
+  /// The planned place pose, raised where the tool (closed on the tube) would come nearer to the
+  /// place surface than tool.margin (place_surface_height); recorded as record["place_raised"].
+  Eigen::Isometry3d ClearOfThePlaceSurface(const Eigen::Isometry3d& X_BinTcpPlanned, Attempt& attempt) const;
   /// From the current pose straight down to the place pose in steps of place_step, reading the F/T
   /// after each; stops where the tube no longer weighs a tube (it rests on the place surface).
   void DescendOntoPlace(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,

@@ -129,6 +129,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
   v("put_back_step", p.put_back_step, "m: down to it in steps, opening where they rest; 0 = one move");
   v("place_approach_height", p.place_approach_height, "m above the place pose");
   v("place_recheck_height", p.place_recheck_height, "m higher again when the load there is light");
+  v("place_surface_height", p.place_surface_height,
+    "bin z of the surface tubes are placed on; the tool stays tool.margin above it");
   v("place_step", p.place_step,
     "m: down to the place pose in steps, opening where the tube rests; 0 = one move");
   v("safe_release_height", p.safe_release_height,

@@ -101,6 +101,13 @@ struct CellControllerParams {
   /// simulated 20-tree bins (docs/ACCURACY.md) the planned descent pressed held trees on the
   /// place zone with 50-200 N.
   double place_step = 0.02;
+  /// Height (bin z) of the surface the place zone's tubes are laid on. A planned place pose that
+  /// would bring the tool (`tool`, closed on the tube) nearer to it than tool.margin is raised
+  /// until it clears (the planner places the tube's frame, not the tool: a tube grasped where it
+  /// lay lowest is placed with the fingers lowest). 0 = the bin floor's level, the simulated
+  /// cell's ground. In a simulated 20-tree bin (docs/ACCURACY.md) a planned place pose put a
+  /// finger 2 mm into the ground: a protective stop with the tree held.
+  double place_surface_height = 0.0;
   /// Where the robot waits while the bin is scanned (out of the scanner's view). Absent: above the
   /// cell's placement frame at transit height, TCP pointing down.
   std::optional<Eigen::Isometry3d> X_BinHome;

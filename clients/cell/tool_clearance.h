@@ -26,4 +26,8 @@ std::optional<std::string> ToolClearanceProblem(const CellConfig& cell, const To
                                                 const Eigen::Isometry3d& X_BinTcpGrasp, double opening,
                                                 const std::vector<Eigen::Vector3d>& waypoints);
 
+/// The lowest point (bin z) of the tool opened to `opening` at X_BinTcp: the lowest corner of its
+/// boxes (ToolBoxes), metres.
+double ToolLowestZ(const ToolGeometry& tool, double opening, const Eigen::Isometry3d& X_BinTcp);
+
 }  // namespace tubepick::cell

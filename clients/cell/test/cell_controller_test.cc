@@ -1488,6 +1488,24 @@ TEST_F(PlaceDescentTest, ATubeThatHangsAsModeledGoesDownToThePlacePoseInSteps) {
   for (std::size_t i = 0; i < stops.size(); ++i) EXPECT_NEAR(stops[i], 0.20 - 0.02 * i, kTol) << i;
   EXPECT_TRUE(gripper.opened_at[1].isApprox(testing::PlacePose().translation(), kTol));
   EXPECT_FALSE(Records("attempt").at(0).contains("place_touchdown"));
+  EXPECT_FALSE(Records("attempt").at(0).contains("place_raised"));  // the tool clears the ground
+}
+
+TEST_F(PlaceDescentTest, APlacePoseThatWouldPutAFingerIntoThePlaceSurfaceIsRaisedUntilTheToolClears) {
+  // The place pose's TCP at z 0.12, the fingertips 5 mm below it: with the surface at 0.12 the
+  // tool must rise by 5 mm + tool.margin (3 mm) to clear it.
+  params.place_surface_height = 0.12;
+  ft.readings = {Reading(0.10), Reading(0.64)};  // one tube from the lift on
+  const CellRunResult result = Run();
+  EXPECT_FALSE(result.fault) << result.message;
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  const double raised = params.tool.finger_tip_depth + params.tool.margin;
+  ASSERT_GE(gripper.opened_at.size(), 2u);
+  EXPECT_NEAR(gripper.opened_at[1].z(), testing::PlacePose().translation().z() + raised, kTol);
+  const std::vector<double> stops = StopsAboveThePlace();
+  ASSERT_FALSE(stops.empty());
+  EXPECT_NEAR(*std::min_element(stops.begin(), stops.end()), 0.12 + raised, kTol);  // never lower
+  EXPECT_NEAR(Records("attempt").at(0)["place_raised"].get<double>(), raised, kTol);
 }
 
 TEST_F(PlaceDescentTest, ATubeJammedOnThePlaceSurfaceIsReleasedWhereTheReadingsStartToDisagree) {
