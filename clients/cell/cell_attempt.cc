@@ -406,8 +406,8 @@ Eigen::Isometry3d CellController::ClearOfThePlaceSurface(const Eigen::Isometry3d
   spdlog::info(
       "cell: round {}: the planned place pose would bring the tool to z {:.3f} m, {:.3f} m from the place "
       "surface (place_surface_height {:.3f} m, tool.margin {:.3f} m): placing {:.3f} m higher",
-      round_, lowest, lowest - params_.place_surface_height, params_.place_surface_height, params_.tool.margin,
-      clear - lowest);
+      round_, lowest, lowest - params_.place_surface_height, params_.place_surface_height,
+      params_.tool.margin, clear - lowest);
   return X_BinTcpPlace;
 }
 

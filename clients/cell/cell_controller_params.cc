@@ -60,8 +60,8 @@ void CellControllerParams::Validate() const {
   RequireNonNegativeValue(place_recheck_height, "place_recheck_height");
   RequireNonNegativeValue(place_step, "place_step");
   if (!std::isfinite(place_surface_height))
-    throw InvalidArgument(fmt::format("cell controller place_surface_height: must be finite, got {}",
-                                      place_surface_height));
+    throw InvalidArgument(
+        fmt::format("cell controller place_surface_height: must be finite, got {}", place_surface_height));
   RequireNonNegativeValue(safe_release_step, "safe_release_step");
   RequirePositiveValue(safe_release_height, "safe_release_height");
   if (X_BinHome && !X_BinHome->matrix().allFinite())

@@ -18,7 +18,8 @@ double ToolLowestZ(const ToolGeometry& tool, double opening, const Eigen::Isomet
   double lowest = std::numeric_limits<double>::infinity();
   for (const ToolBox& box : ToolBoxes(tool, opening)) {
     for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0, (corner & 4) ? 1.0 : -1.0);
+      const Eigen::Vector3d sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
+                                 (corner & 4) ? 1.0 : -1.0);
       lowest = std::min(lowest, (X_BinTcp * (box.centre_Tcp + sign.cwiseProduct(box.half_size))).z());
     }
   }
