@@ -397,17 +397,15 @@ void CellController::Place(const Eigen::Isometry3d& X_BinTcpPlanned, const devic
 
 Eigen::Isometry3d CellController::ClearOfThePlaceSurface(const Eigen::Isometry3d& X_BinTcpPlanned,
                                                          Attempt& attempt) const {
-  const double lowest = ToolLowestZ(params_.tool, 2.0 * cell_.tube.radius, X_BinTcpPlanned);
-  const double clear = params_.place_surface_height + params_.tool.margin;
-  if (lowest >= clear) return X_BinTcpPlanned;
-  Eigen::Isometry3d X_BinTcpPlace = X_BinTcpPlanned;
-  X_BinTcpPlace.translation().z() += clear - lowest;
-  attempt.record["place_raised"] = clear - lowest;
+  const Eigen::Isometry3d X_BinTcpPlace =
+      PlacePoseClearOfTheSurface(params_, cell_.tube.radius, X_BinTcpPlanned);
+  const double raised = X_BinTcpPlace.translation().z() - X_BinTcpPlanned.translation().z();
+  if (raised <= 0.0) return X_BinTcpPlace;
+  attempt.record["place_raised"] = raised;
   spdlog::info(
-      "cell: round {}: the planned place pose would bring the tool to z {:.3f} m, {:.3f} m from the place "
-      "surface (place_surface_height {:.3f} m, tool.margin {:.3f} m): placing {:.3f} m higher",
-      round_, lowest, lowest - params_.place_surface_height, params_.place_surface_height,
-      params_.tool.margin, clear - lowest);
+      "cell: round {}: the planned place pose would bring the tool {:.3f} m from the place surface "
+      "(place_surface_height {:.3f} m, tool.margin {:.3f} m): placing {:.3f} m higher",
+      round_, params_.tool.margin - raised, params_.place_surface_height, params_.tool.margin, raised);
   return X_BinTcpPlace;
 }
 

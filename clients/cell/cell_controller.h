@@ -447,7 +447,7 @@ class CellController {
   /// put_back_margin inside the walls (PlanPutBackShift); recorded under record["resolution"].
   Eigen::Isometry3d PutBackPose(const devices::WrenchReading& reference, const devices::WrenchReading& held,
                                 const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) const;
-  void Place(const Eigen::Isometry3d& X_BinTcpPlace, const devices::WrenchReading& reference,
+  void Place(const Eigen::Isometry3d& X_BinTcpPlanned, const devices::WrenchReading& reference,
              Attempt& attempt);
   /// The planned place pose, raised where the tool (closed on the tube) would come nearer to the
   /// place surface than tool.margin (place_surface_height); recorded as record["place_raised"].

@@ -141,6 +141,15 @@ std::vector<Eigen::Isometry3d> DescentSteps(double step, const Eigen::Isometry3d
   return out;
 }
 
+Eigen::Isometry3d PlacePoseClearOfTheSurface(const CellControllerParams& params, double tube_radius,
+                                             const Eigen::Isometry3d& X_BinTcpPlanned) {
+  const double lowest = ToolLowestZ(params.tool, 2.0 * tube_radius, X_BinTcpPlanned);
+  const double clear = params.place_surface_height + params.tool.margin;
+  Eigen::Isometry3d X_BinTcpPlace = X_BinTcpPlanned;
+  if (lowest < clear) X_BinTcpPlace.translation().z() += clear - lowest;
+  return X_BinTcpPlace;
+}
+
 std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,
                                                  const Eigen::Isometry3d& X_BinTcpFrom,
                                                  const Eigen::Isometry3d& X_BinTcpPlace) {

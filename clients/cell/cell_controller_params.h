@@ -216,6 +216,10 @@ double TransitHeight(const CellControllerParams& params, const CellConfig& cell)
 /// of at most `step` stops, top down, neither end included; none when step is 0.
 std::vector<Eigen::Isometry3d> DescentSteps(double step, const Eigen::Isometry3d& X_BinTcpFrom,
                                             const Eigen::Isometry3d& X_BinTcpTo);
+/// The planned place pose, raised until the tool closed on a tube of `tube_radius` keeps
+/// tool.margin above place_surface_height (ToolLowestZ of its boxes); unchanged when it does.
+Eigen::Isometry3d PlacePoseClearOfTheSurface(const CellControllerParams& params, double tube_radius,
+                                             const Eigen::Isometry3d& X_BinTcpPlanned);
 /// The poses between `X_BinTcpFrom` (straight above the place pose) and `X_BinTcpPlace` where the
 /// place descent stops to read the F/T (place_step), top down, neither end included.
 std::vector<Eigen::Isometry3d> PlaceDescentSteps(const CellControllerParams& params,

@@ -92,13 +92,16 @@ std::vector<PlannedMotion> CellController::PlannedMotions(const PlanPoses& poses
   robot(MotionKind::kMoveThrough, CellState::kLift, "lift along the plan's waypoints", X_BinTcpLift,
         params_.lift_speed)
       .waypoints_Bin = poses.waypoints_Bin;
-  Eigen::Isometry3d X_BinTcpAbovePlace = poses.X_BinTcpPlace;
+  // As Place: the planned pose raised where the closed tool would touch the place surface.
+  const Eigen::Isometry3d X_BinTcpPlace =
+      PlacePoseClearOfTheSurface(params_, cell_.tube.radius, poses.X_BinTcpPlace);
+  Eigen::Isometry3d X_BinTcpAbovePlace = X_BinTcpPlace;
   X_BinTcpAbovePlace.translation().z() += params_.place_approach_height;
   transit(CellState::kPlace, "transit above the place pose", X_BinTcpLift, X_BinTcpAbovePlace);
   robot(MotionKind::kMoveTo, CellState::kPlace, "down to the place pose (opens where the tube rests)",
-        poses.X_BinTcpPlace, params_.approach_speed)
-      .via = PlaceDescentSteps(params_, X_BinTcpAbovePlace, poses.X_BinTcpPlace);
-  gripper(MotionKind::kGripperOpen, CellState::kPlace, "open: the tube is placed", poses.X_BinTcpPlace, 0.0,
+        X_BinTcpPlace, params_.approach_speed)
+      .via = PlaceDescentSteps(params_, X_BinTcpAbovePlace, X_BinTcpPlace);
+  gripper(MotionKind::kGripperOpen, CellState::kPlace, "open: the tube is placed", X_BinTcpPlace, 0.0,
           std::nullopt, std::nullopt);
   robot(MotionKind::kMoveTo, CellState::kPlace, "back up above the place pose", X_BinTcpAbovePlace,
         params_.approach_speed);

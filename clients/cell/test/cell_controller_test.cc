@@ -57,6 +57,9 @@ class CellControllerTest : public ::testing::Test {
     return result;
   }
 
+  /// The dry run of plan MakePlan(4, p_Bin_grasp) against a run of the same plan: after the
+  /// start's way home, the robot gets exactly the dry run's commands.
+  void ExpectTheDryRunIsTheRun();
   DryRunResult DryRun() {
     CellController controller({&scanner, &robot, &gripper, &ft}, planner, cell, params, &sink);
     if (observer) controller.set_state_observer(observer);
@@ -2273,7 +2276,16 @@ TEST_F(CellControllerTest, DryRunMovesNothingAndListsTheCommandsOfTheBestExecuta
   EXPECT_NE(text.find("skipped plan 0 (tube 1): cell check:"), std::string::npos) << text;
 }
 
-TEST_F(CellControllerTest, DryRunListsExactlyTheRobotCommandsOfARun) {
+TEST_F(CellControllerTest, DryRunListsExactlyTheRobotCommandsOfARun) { ExpectTheDryRunIsTheRun(); }
+
+TEST_F(CellControllerTest, DryRunRaisesThePlacePoseAsTheRunDoes) {
+  params.place_surface_height = 0.12;  // the place pose's TCP at 0.12: raised by 8 mm
+  ExpectTheDryRunIsTheRun();
+  EXPECT_NEAR(Records("attempt").at(0)["place_raised"].get<double>(),
+              params.tool.finger_tip_depth + params.tool.margin, kTol);
+}
+
+void CellControllerTest::ExpectTheDryRunIsTheRun() {
   planner.plan_answers.push_back(Plans({MakePlan(4, p_Bin_grasp)}, 1));
   const DryRunResult dry = DryRun();
   ASSERT_FALSE(dry.motions.empty()) << dry.run.message;
