@@ -17,11 +17,7 @@ std::optional<std::string> ToolClearanceProblem(const CellConfig& cell, const To
 double ToolLowestZ(const ToolGeometry& tool, double opening, const Eigen::Isometry3d& X_BinTcp) {
   double lowest = std::numeric_limits<double>::infinity();
   for (const ToolBox& box : ToolBoxes(tool, opening)) {
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
-                                 (corner & 4) ? 1.0 : -1.0);
-      lowest = std::min(lowest, (X_BinTcp * (box.centre_Tcp + sign.cwiseProduct(box.half_size))).z());
-    }
+    for (int corner = 0; corner < 8; ++corner) lowest = std::min(lowest, (X_BinTcp * box.Corner(corner)).z());
   }
   return lowest;
 }

@@ -43,10 +43,7 @@ std::optional<ToolClearanceIssue> ToolClearanceProblem(const BinConfig& bin, con
     if (!waypoints.empty()) X.translation() += waypoints[w];
     for (const ToolBox& box : boxes) {
       for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3d offset((corner & 1 ? 1 : -1) * box.half_size.x(),
-                                     (corner & 2 ? 1 : -1) * box.half_size.y(),
-                                     (corner & 4 ? 1 : -1) * box.half_size.z());
-        const Eigen::Vector3d p = X * (box.centre_Tcp + offset);
+        const Eigen::Vector3d p = X * box.Corner(corner);
         if (p.z() < tool.margin) return ToolClearanceIssue{box.part, "floor", tool.margin - p.z(), w, p};
         if (p.z() >= wall_top) continue;
         const double past_x = std::abs(p.x()) - (half_bin.x() - tool.margin);

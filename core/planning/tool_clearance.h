@@ -38,6 +38,12 @@ struct ToolBox {
   const char* part = "";
   Eigen::Vector3d centre_Tcp = Eigen::Vector3d::Zero();
   Eigen::Vector3d half_size = Eigen::Vector3d::Zero();
+
+  /// Corner `k` (0..7; bits 0, 1, 2 pick the + side along x, y, z), TCP frame.
+  Eigen::Vector3d Corner(int k) const {
+    return centre_Tcp + Eigen::Vector3d((k & 1 ? 1 : -1) * half_size.x(), (k & 2 ? 1 : -1) * half_size.y(),
+                                        (k & 4 ? 1 : -1) * half_size.z());
+  }
 };
 
 /// The two pads and the housing of `tool` opened to `opening` (distance between the pads' inner
