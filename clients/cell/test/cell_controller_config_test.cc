@@ -269,6 +269,10 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
   EXPECT_NE(ParseError("home_pose_in_bin:\n  position: [0, 0, 1]\n").find("home_pose_in_bin: needs"),
             std::string::npos);
   EXPECT_NE(ParseError("gripper_force: .nan\n").find("gripper_force"), std::string::npos);
+  EXPECT_NE(
+      ParseError("place_surface_height: .inf\n").find("place_surface_height: value must be finite, got inf"),
+      std::string::npos)
+      << ParseError("place_surface_height: .inf\n");
 }
 
 TEST(CellControllerConfigTest, FaultHandlingKeysRejectBadValuesNamingThem) {

@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <thread>
 
 #include "clients/cell/cell_statistics.h"
@@ -2362,6 +2363,16 @@ TEST(CellControllerParamsTest, InvalidValuesNameTheField) {
   params = CellControllerParams{};
   params.max_attempts_per_tube = 0;
   EXPECT_THROW(params.Validate(), InvalidArgument);
+  // A place surface at no height would let the place pose through unraised.
+  params = CellControllerParams{};
+  params.place_surface_height = std::numeric_limits<double>::quiet_NaN();
+  try {
+    params.Validate();
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("place_surface_height: must be finite, got nan"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
