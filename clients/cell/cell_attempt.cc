@@ -283,20 +283,31 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
   devices::WrenchReading held = lifted;
   const devices::RobotLimits limits = devices_.robot->Limits();
+  // The analysis of the reading after the last motion driven (resolution_replan).
+  std::optional<v1::AnalyzeWrenchResponse> again;
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
-    const v1::ResolutionMotion& motion = analysis.resolution_motions(m);
-    if (const std::optional<std::string> problem = ResolutionReachProblem(limits, motion, m, shift, state_)) {
+    // Replanned: the first motion of the reading at the hold pose, planned about the TCP there.
+    const bool replanned = params_.resolution_replan && again && again->resolution_motions_size() > 0;
+    const v1::ResolutionMotion& motion =
+        replanned ? again->resolution_motions(0) : analysis.resolution_motions(m);
+    const Eigen::Translation3d motion_shift = replanned ? Eigen::Translation3d::Identity() : shift;
+    if (const std::optional<std::string> problem =
+            ResolutionReachProblem(limits, motion, m, motion_shift, state_)) {
       spdlog::info("cell: round {}: resolution motion {} skipped, beyond the robot's limits at {}", round_, m,
                    *problem);
       resolution["beyond_limits"].push_back({{"motion", m}, {"problem", *problem}});
       continue;
     }
+    if (replanned) {
+      spdlog::info("cell: round {}: resolution motion {} planned from the reading after motion {}: {}",
+                   round_, m, m - 1, motion.description());
+      resolution["replanned"].push_back(m);
+    }
     resolution["used"] = m + 1;
-    const v1::AnalyzeWrenchResponse again =
-        ResolutionMotion(motion, m, reference, shift, X_BinTcpHold, attempt, &held);
-    if (again.outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
+    again = ResolutionMotion(motion, m, reference, motion_shift, X_BinTcpHold, attempt, &held);
+    if (again->outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
-            Conclude(again.outcome(), poses.X_BinTcpPlace, reference, attempt))
+            Conclude(again->outcome(), poses.X_BinTcpPlace, reference, attempt))
       return *result;
   }
   const Eigen::Isometry3d X_BinTcpPutBack = PutBackPose(reference, held, X_BinTcpLift, attempt);

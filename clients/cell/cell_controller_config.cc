@@ -122,6 +122,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
     "carry several tubes over the bin's middle before the resolution rotation");
   v("resolution_wall_margin", p.resolution_wall_margin, "m, the TCP inside the bin walls while it does");
   v("resolution_dwell", p.resolution_dwell, "s, each resolution motion pauses at its tilt; 0 = none");
+  v("resolution_replan", p.resolution_replan,
+    "a motion that left several tubes: the next one planned from the reading after it, at the hold pose");
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");

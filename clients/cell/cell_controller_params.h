@@ -55,6 +55,15 @@ struct CellControllerParams {
   /// of 24 rubber and 22 of 31 pvc double picks against 9 and 21 without, no tube more outside the
   /// bin (docs/ACCURACY.md). 0 = turn back at once (the thesis).
   double resolution_dwell = 1.5;
+  /// A motion that left several tubes: the next one is the first motion the planner gives for the
+  /// reading taken at the hold pose after it (about the torque axis the tangle shows now), turned
+  /// about the TCP there, rather than the next motion planned from the lift's reading; as many
+  /// motions as that plan had. On generated set-C bins (`tubepick resolution-trials --replan`, the
+  /// same double picks either way) the second motion then freed 6 of 8 tangles of 20 pvc trees
+  /// (against 4 about the perpendicular) and 1 of 13 of 10 rubber trees (against 0), and lost none
+  /// (docs/ACCURACY.md). false: the lift plan's motions in order (torque_axis_then_perpendicular's
+  /// perpendicular second).
+  bool resolution_replan = true;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.

@@ -621,6 +621,65 @@ TEST_F(CellControllerTest, WithoutTheHoldTheRotationTurnsAtTheLiftPose) {
   EXPECT_EQ(a["resolution"]["hold_shift"], json::array({0.0, 0.0}));
 }
 
+/// A double pick whose first motion (about the lift reading's torque axis) frees nothing. The
+/// lift plan's second motion turns -0.7 rad about y; the reading at the hold pose after the first
+/// plans its own, 0.6 rad about x there. The second frees one tube either way.
+class ResolutionReplanTest : public CellControllerTest {
+ protected:
+  void Drive(bool replan) {
+    params.resolution_replan = replan;
+    planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
+    v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
+    AddWaypoint(multiple, 0, X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
+    AddWaypoint(multiple, 1, X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
+    const ResolutionHold hold =
+        PlanResolutionHold(devices::AsWrench(Reading(0.1)), devices::AsWrench(Reading(1.3, 0.03, -0.01)),
+                           X_BinTcpLift, cell.bin.inner_size, params.resolution_wall_margin);
+    shift = Eigen::Translation3d(hold.shift_Bin);
+    v1::AnalyzeWrenchResponse still = Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9, 1);
+    AddWaypoint(still, 0, shift * X_BinTcpLift * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitX()));
+    planner.wrench_answers = {multiple, still, Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
+    ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(1.2, -0.02, 0.02), Reading(0.66)};
+    result = Run();
+  }
+
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
+  Eigen::Translation3d shift = Eigen::Translation3d::Identity();
+  CellRunResult result;
+};
+
+TEST_F(ResolutionReplanTest, TheSecondMotionIsPlannedFromTheReadingAfterTheFirst) {
+  Drive(/*replan=*/true);
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  ASSERT_GT(shift.translation().norm(), 0.05);
+  EXPECT_TRUE(robot.Visited(shift * X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())));
+  // The hold pose's own motion, not shifted again; the lift plan's second motion not driven.
+  EXPECT_TRUE(robot.Visited(shift * X_BinTcpLift * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitX())));
+  EXPECT_FALSE(robot.Visited(shift * X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY())));
+  EXPECT_FALSE(
+      robot.Visited(shift * shift * X_BinTcpLift * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitX())));
+  // The reading it was planned from: taken at the hold pose after the first motion.
+  ASSERT_EQ(planner.wrench_requests.size(), 3u);
+  EXPECT_TRUE(
+      FromProto(planner.wrench_requests[1].tcp_pose(), "tcp_pose").isApprox(shift * X_BinTcpLift, kTol));
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[1].current().torque().x(), -0.02);
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["resolution"]["replanned"], json::array({1}));
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+}
+
+TEST_F(ResolutionReplanTest, WithoutReplanTheLiftPlansMotionsRunInOrder) {
+  Drive(/*replan=*/false);
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(shift * X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY())));
+  EXPECT_FALSE(robot.Visited(shift * X_BinTcpLift * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitX())));
+  const json a = Records("attempt").at(0);
+  EXPECT_FALSE(a["resolution"].contains("replanned"));
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+}
+
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
   planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
   const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));

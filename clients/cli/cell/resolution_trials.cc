@@ -63,7 +63,8 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::Ce
 
 // The resolution as the controller runs it: with hold_over_bin, first to the hold pose
 // (PlanResolutionHold) and every waypoint shifted with it; each motion followed by the return to the
-// hold pose and a reading, until the F/T says one tube (or none).
+// hold pose and a reading, until the F/T says one tube (or none). With resolution_replan, each
+// motion after the first is the first one planned from that reading at the hold pose.
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
              ResolutionTrial& trial, Wrench* held) {
@@ -77,10 +78,13 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
   const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
   trial.hold_shift = shift.translation().norm();
   cell.robot().MoveTo(X_BinTcpHold, c.lift_speed, kLong);
-  for (const ResolutionMotion& motion : plan.motions) {
+  std::optional<ResolutionPlan> replanned;  // from the reading after the last motion, at the hold pose
+  for (const ResolutionMotion& planned : plan.motions) {
+    const ResolutionMotion& motion = replanned ? replanned->motions.front() : planned;
+    const Eigen::Translation3d motion_shift = replanned ? Eigen::Translation3d::Identity() : shift;
     ++trial.motions_used;
     for (const ResolutionWaypoint& w : motion.waypoints)
-      cell.robot().MoveTo(shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
+      cell.robot().MoveTo(motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (c.resolution_dwell > 0.0) cell.robot().Hold(c.resolution_dwell, kLong);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     *held = AsWrench(cell.ft_sensor().Read(kLong));
@@ -89,6 +93,7 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
       trial.freed = again.outcome == HeldOutcome::kSingle;
       return;
     }
+    if (c.resolution_replan) replanned = PlanResolutionRotation(reference, *held, X_BinTcpHold, params);
   }
 }
 
@@ -402,6 +407,7 @@ void RunTrials(const ResolutionTrialsOptions& o) {
                               {"tubes", o.tubes},
                               {"lift", o.trial.lift},
                               {"dwell", o.trial.controller.resolution_dwell},
+                              {"replan", o.trial.controller.resolution_replan},
                               {"trials", nlohmann::json::array()}};
         for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
         json.push_back(arm);
@@ -479,6 +485,10 @@ void AddResolutionTrialsCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--dwell", o->trial.controller.resolution_dwell,
                   "Pause at each resolution motion's tilt, seconds (the controller's resolution_dwell)")
+      ->capture_default_str();
+  cmd->add_option("--replan", o->trial.controller.resolution_replan,
+                  "Each motion after the first planned from the reading after the one before, at the hold "
+                  "pose (the controller's resolution_replan)")
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")

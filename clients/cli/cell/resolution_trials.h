@@ -74,8 +74,9 @@ struct TrialParams {
   bool resolve = true;
   /// The controller's speeds, approach and release heights, resolution hold
   /// (resolution_hold_over_bin: the payload brought over the bin's middle, PlanResolutionHold,
-  /// before the rotation, the TCP resolution_wall_margin inside the walls) and the pause at each
-  /// motion's tilt (resolution_dwell).
+  /// before the rotation, the TCP resolution_wall_margin inside the walls), the pause at each
+  /// motion's tilt (resolution_dwell) and the motions after the first planned from the reading
+  /// before them (resolution_replan).
   cell::CellControllerParams controller;
 };
 
