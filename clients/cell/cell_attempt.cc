@@ -321,10 +321,26 @@ Eigen::Isometry3d CellController::PutBackPose(const devices::WrenchReading& refe
                                               const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt) const {
   const Payload payload =
       PayloadOnTool(devices::AsWrench(reference), devices::AsWrench(held), X_BinTcpLift.linear());
-  const Eigen::Vector3d shift_Bin = PlanPutBackShift(X_BinTcpLift.translation(), payload.p_TcpPayload_Bin,
-                                                     cell_.bin.inner_size, params_.put_back_margin);
   nlohmann::json& resolution = attempt.record["resolution"];
   resolution["put_back_payload_offset"] = {payload.p_TcpPayload_Bin.x(), payload.p_TcpPayload_Bin.y()};
+  // Tubes hanging from the tool have their centre of mass within a tube's length of it. Farther, the
+  // reading is no free-hanging load (a tube pulling on the payload from the heap or a wall): it
+  // says nothing of where the tangle would lie down, so the put-back is where the lift was.
+  const double offset = payload.p_TcpPayload_Bin.norm();
+  const bool believable = !(cell_.tube.length > 0.0) || offset <= cell_.tube.length;
+  if (!believable) {
+    spdlog::warn(
+        "cell: round {}: the reading after the resolution puts the payload's centre of mass {:.2f} m from "
+        "the "
+        "TCP ({:.2f} N, {:.2f} N*m), farther than a tube's length ({:.2f} m): not a load hanging free "
+        "(something pulls on it?); put back where it was lifted",
+        round_, offset, payload.weight, (held.torque - reference.torque).norm(), cell_.tube.length);
+    resolution["put_back_payload_implausible"] = true;
+  }
+  const Eigen::Vector3d shift_Bin =
+      believable ? PlanPutBackShift(X_BinTcpLift.translation(), payload.p_TcpPayload_Bin,
+                                    cell_.bin.inner_size, params_.put_back_margin)
+                 : Eigen::Vector3d::Zero();
   resolution["put_back_shift"] = {shift_Bin.x(), shift_Bin.y()};
   if (!shift_Bin.isZero()) {
     const Eigen::Vector3d p_Bin_payload = X_BinTcpLift.translation() + payload.p_TcpPayload_Bin;

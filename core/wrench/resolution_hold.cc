@@ -54,6 +54,11 @@ Eigen::Vector3d PlanPutBackShift(const Eigen::Vector3d& p_Bin_tcp, const Eigen::
     const double reach = std::max(0.0, 0.5 * bin_inner_size[axis] - margin);
     const double centre = p_Bin_tcp[axis] + p_TcpPayload_Bin[axis];
     shift[axis] = std::clamp(centre, -reach, reach) - centre;
+    // The TCP itself never goes further out than it was or than `reach`: a reading that puts the
+    // centre of mass far past a wall (something pulling on the payload) must not carry the tool
+    // over the opposite one.
+    const double bound = std::max(std::abs(p_Bin_tcp[axis]), reach);
+    shift[axis] = std::clamp(p_Bin_tcp[axis] + shift[axis], -bound, bound) - p_Bin_tcp[axis];
   }
   return shift;
 }

@@ -43,8 +43,10 @@ Payload PayloadOnTool(const Wrench& reference, const Wrench& now, const Eigen::M
 /// Translation (bin frame, z = 0) that brings a payload's centre of mass, hanging at
 /// p_TcpPayload_Bin from a TCP at p_Bin_tcp, at least `margin` inside the bin's inner walls, and no
 /// further: per axis, zero where it already is, to the bin's middle where the bin is narrower than
-/// two margins. Where several tubes the resolution could not free are put back: lowered where they
-/// hang, they lie down where they came from, but a centre of mass at a wall lays them over it.
+/// two margins. The TCP never moves further out than it was or than `margin` inside the walls, per
+/// axis, whatever the centre of mass: a reading far past a wall is no free-hanging load. Where
+/// several tubes the resolution could not free are put back: lowered where they hang, they lie down
+/// where they came from, but a centre of mass at a wall lays them over it.
 /// @throws InvalidArgument when a vector is not finite or margin < 0 (named put_back_margin).
 Eigen::Vector3d PlanPutBackShift(const Eigen::Vector3d& p_Bin_tcp, const Eigen::Vector3d& p_TcpPayload_Bin,
                                  const Eigen::Vector3d& bin_inner_size, double margin);

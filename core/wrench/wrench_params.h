@@ -23,6 +23,9 @@ enum class ResolutionVariant {
   /// perpendicular to ΔM (kPerpendicular's first motion; not its second, −angle, which threw six
   /// trees out of a bin in one of 33 simulated double picks). On 33 double picks of pvc set-C
   /// trees it freed 23 against kTorqueAxis's 19, with no tube outside the bin (docs/ACCURACY.md).
+  /// A caller that reads the F/T between motions can plan the second from that reading instead
+  /// (its first motion: the torque axis the tangle shows then), as the cell controller does with
+  /// resolution_replan.
   kTorqueAxisThenPerpendicular,
 };
 

@@ -735,6 +735,33 @@ TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpened
   EXPECT_EQ(a["result"], "multiple_returned");
 }
 
+TEST_F(CellControllerTest, AReadingNoHangingLoadGivesIsPutBackWhereLiftedNotCarriedAway) {
+  // Seed 14 of the 20-tree bins (2026-12-07): after a resolution motion the F/T read two trees'
+  // weight with 1.9 N*m, a centre of mass 1.2 m from the TCP, and the put-back went 1.1 m over a
+  // wall. Here 1.2 N with 0.98 N*m: 0.82 m, beyond a 0.5 m tube.
+  planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
+  const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
+  v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 1);
+  AddWaypoint(multiple, 0, X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
+  planner.wrench_answers = {multiple, Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0)};
+  ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(1.3, 0.9, -0.4)};
+  ft.held_force = 2.0 * 1.08;
+  ft.tcp = &robot.X_BinTcp;
+  ft.rests_below_z = 0.25;
+  params.resolution_dwell = 0.0;
+  ASSERT_LT(cell.tube.length, 0.8);
+
+  const CellRunResult result = Run();
+  EXPECT_EQ(result.picks, 0u) << result.message;
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["result"], "multiple_returned");
+  EXPECT_EQ(a["resolution"]["put_back_payload_implausible"], true);
+  EXPECT_EQ(a["resolution"]["put_back_shift"], json::array({0.0, 0.0}));
+  EXPECT_TRUE(std::any_of(gripper.opened_at.begin(), gripper.opened_at.end(), [&](const Eigen::Vector3d& p) {
+    return std::abs(p.x() - p_Bin_grasp.x()) < kTol && std::abs(p.y() - p_Bin_grasp.y()) < kTol;
+  }));
+}
+
 TEST_F(CellControllerTest, AResolutionMotionBeyondTheWristLimitIsSkippedNotDriven) {
   // The first motion turns the tool 0.7 rad past a 0.5 rad wrist limit (a tool tilted at the
   // grasp, turned further); the second stays within it and frees a tube.

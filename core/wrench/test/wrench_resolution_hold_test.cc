@@ -117,6 +117,18 @@ TEST(PutBackShift, MovesACentreOfMassAtAWallOnlyAsFarInsideAsTheMarginAsks) {
   EXPECT_NEAR(PlanPutBackShift({0.0, 0.1, 0.45}, {0.0, 0.05, 0.0}, kBin, 0.4).y(), -0.15, 1e-12);
 }
 
+TEST(PutBackShift, NeverCarriesTheToolOutOfTheBinWhateverTheReadingSays) {
+  // Seed 14 of the 20-tree bins (2026-12-07): after a resolution motion the F/T read 1.66 N with
+  // 1.9 N·m of torque, a centre of mass 1.23 m to the TCP's -y side, past the -y wall. Clamping
+  // that centre alone moved the TCP 1.11 m along +y, over the +y wall, and the tangle was put
+  // down outside the bin. The TCP now stops 0.15 m inside the +y wall.
+  const Eigen::Vector3d shift = PlanPutBackShift({-0.16, -0.035, 0.45}, {0.04, -1.23, 0.0}, kBin, 0.15);
+  EXPECT_NEAR(-0.035 + shift.y(), 0.15, 1e-12);
+  EXPECT_EQ(shift.x(), 0.0);
+  // A TCP already nearer a wall than the margin is not moved further out by it either.
+  EXPECT_NEAR(0.25 + PlanPutBackShift({0.0, 0.25, 0.45}, {0.0, -0.9, 0.0}, kBin, 0.15).y(), 0.25, 1e-12);
+}
+
 TEST(PutBackShift, RejectsANegativeMarginByName) {
   try {
     PlanPutBackShift({0.0, 0.0, 0.4}, {0.0, 0.0, 0.0}, kBin, -0.1);
