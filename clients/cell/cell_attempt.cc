@@ -283,8 +283,9 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
   devices::WrenchReading held = lifted;
   const devices::RobotLimits limits = devices_.robot->Limits();
-  // The analysis of the reading after the last motion driven (resolution_replan).
+  // The analysis of the reading after the last motion driven, `again_after` (resolution_replan).
   std::optional<v1::AnalyzeWrenchResponse> again;
+  int again_after = -1;
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
     // Replanned: the first motion of the reading at the hold pose, planned about the TCP there.
     const bool replanned = params_.resolution_replan && again && again->resolution_motions_size() > 0;
@@ -300,11 +301,12 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
     }
     if (replanned) {
       spdlog::info("cell: round {}: resolution motion {} planned from the reading after motion {}: {}",
-                   round_, m, m - 1, motion.description());
+                   round_, m, again_after, motion.description());
       resolution["replanned"].push_back(m);
     }
     resolution["used"] = m + 1;
     again = ResolutionMotion(motion, m, reference, motion_shift, X_BinTcpHold, attempt, &held);
+    again_after = m;
     if (again->outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
             Conclude(again->outcome(), poses.X_BinTcpPlace, reference, attempt))
@@ -323,18 +325,16 @@ Eigen::Isometry3d CellController::PutBackPose(const devices::WrenchReading& refe
       PayloadOnTool(devices::AsWrench(reference), devices::AsWrench(held), X_BinTcpLift.linear());
   nlohmann::json& resolution = attempt.record["resolution"];
   resolution["put_back_payload_offset"] = {payload.p_TcpPayload_Bin.x(), payload.p_TcpPayload_Bin.y()};
-  // Tubes hanging from the tool have their centre of mass within a tube's length of it. Farther, the
-  // reading is no free-hanging load (a tube pulling on the payload from the heap or a wall): it
-  // says nothing of where the tangle would lie down, so the put-back is where the lift was.
-  const double offset = payload.p_TcpPayload_Bin.norm();
-  const bool believable = !(cell_.tube.length > 0.0) || offset <= cell_.tube.length;
+  // A reading no free-hanging load gives says nothing of where the tangle would lie down: the
+  // put-back is where the lift was.
+  const bool believable = HangsFromTheTool(payload, cell_.tube.length);
   if (!believable) {
     spdlog::warn(
-        "cell: round {}: the reading after the resolution puts the payload's centre of mass {:.2f} m from "
-        "the "
-        "TCP ({:.2f} N, {:.2f} N*m), farther than a tube's length ({:.2f} m): not a load hanging free "
-        "(something pulls on it?); put back where it was lifted",
-        round_, offset, payload.weight, (held.torque - reference.torque).norm(), cell_.tube.length);
+        "cell: round {}: the reading after the resolution puts the payload's centre of mass "
+        "{:.2f} m from the TCP ({:.2f} N, {:.2f} N*m), farther than a tube's length ({:.2f} m): "
+        "not a load hanging free (something pulls on it?); put back where it was lifted",
+        round_, payload.p_TcpPayload_Bin.norm(), payload.weight, (held.torque - reference.torque).norm(),
+        cell_.tube.length);
     resolution["put_back_payload_implausible"] = true;
   }
   const Eigen::Vector3d shift_Bin =

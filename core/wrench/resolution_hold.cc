@@ -43,6 +43,10 @@ Payload PayloadOnTool(const Wrench& reference, const Wrench& now, const Eigen::M
   return payload;
 }
 
+bool HangsFromTheTool(const Payload& payload, double tube_length) {
+  return !(tube_length > 0.0) || payload.p_TcpPayload_Bin.norm() <= tube_length;
+}
+
 Eigen::Vector3d PlanPutBackShift(const Eigen::Vector3d& p_Bin_tcp, const Eigen::Vector3d& p_TcpPayload_Bin,
                                  const Eigen::Vector3d& bin_inner_size, double margin) {
   RequireFiniteVector(p_Bin_tcp, "p_Bin_tcp");

@@ -40,6 +40,11 @@ struct Payload {
 /// @throws InvalidArgument when a reading is not finite or R_BinTcp is not a rotation.
 Payload PayloadOnTool(const Wrench& reference, const Wrench& now, const Eigen::Matrix3d& R_BinTcp);
 
+/// Whether `payload` can be tubes hanging from the tool: its centre of mass within `tube_length`
+/// (the cell's tube.length; 0 = unknown: any) of the TCP. Farther, something else pulls on it (a
+/// tube caught on the heap or a wall), and its torque says nothing of where the payload would lie.
+bool HangsFromTheTool(const Payload& payload, double tube_length);
+
 /// Translation (bin frame, z = 0) that brings a payload's centre of mass, hanging at
 /// p_TcpPayload_Bin from a TCP at p_Bin_tcp, at least `margin` inside the bin's inner walls, and no
 /// further: per axis, zero where it already is, to the bin's middle where the bin is narrower than

@@ -112,15 +112,18 @@ std::uint32_t OthersLifted(const SimCell& cell, std::size_t tube) {
 
 // Several tubes not freed, put back as the controller does (CellController::PutBack): from the lift
 // pose, or from further inside when their centre of mass (`held`, the last reading) lies less than
-// put_back_margin inside a wall (PlanPutBackShift), then down in put_back_step steps until less
+// put_back_margin inside a wall (PlanPutBackShift; not for a reading no hanging load gives,
+// HangsFromTheTool), then down in put_back_step steps until less
 // than half a tube's weight hangs on the tool; opened, up, and the tool's load read there.
 void PutBackSeveral(SimCell& cell, const TrialGrasp& grasp, const Wrench& reference, const Wrench& held,
                     const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp, ResolutionTrial& trial) {
   const cell::CellControllerParams& c = tp.controller;
   const Eigen::Matrix3d R_BinTcp = X_BinTcpLift.linear();
-  const Eigen::Vector3d shift =
-      PlanPutBackShift(X_BinTcpLift.translation(), PayloadOnTool(reference, held, R_BinTcp).p_TcpPayload_Bin,
-                       cell.cell().bin.inner_size, c.put_back_margin);
+  const Payload payload = PayloadOnTool(reference, held, R_BinTcp);
+  const Eigen::Vector3d shift = HangsFromTheTool(payload, cell.cell().tube.length)
+                                    ? PlanPutBackShift(X_BinTcpLift.translation(), payload.p_TcpPayload_Bin,
+                                                       cell.cell().bin.inner_size, c.put_back_margin)
+                                    : Eigen::Vector3d::Zero();
   trial.put_back_shift = shift.norm();
   const Eigen::Isometry3d X_BinTcpPutBack = Eigen::Translation3d(shift) * X_BinTcpLift;
   cell.robot().MoveTo(X_BinTcpPutBack, c.lift_speed, kLong);

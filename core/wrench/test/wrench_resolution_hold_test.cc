@@ -129,6 +129,17 @@ TEST(PutBackShift, NeverCarriesTheToolOutOfTheBinWhateverTheReadingSays) {
   EXPECT_NEAR(0.25 + PlanPutBackShift({0.0, 0.25, 0.45}, {0.0, -0.9, 0.0}, kBin, 0.15).y(), 0.25, 1e-12);
 }
 
+TEST(PutBackShift, ACentreOfMassBeyondATubesLengthHangsFromNothing) {
+  Payload payload;
+  payload.weight = 1.64;
+  payload.p_TcpPayload_Bin = Eigen::Vector3d(0.04, -1.23, 0.0);  // seed 14's reading
+  EXPECT_FALSE(HangsFromTheTool(payload, 0.75));
+  EXPECT_TRUE(HangsFromTheTool(payload, 0.0));  // the tube length unknown: not judged
+  payload.p_TcpPayload_Bin = Eigen::Vector3d(0.3, -0.2, 0.0);
+  EXPECT_TRUE(HangsFromTheTool(payload, 0.75));
+  EXPECT_FALSE(HangsFromTheTool(payload, 0.3));
+}
+
 TEST(PutBackShift, RejectsANegativeMarginByName) {
   try {
     PlanPutBackShift({0.0, 0.0, 0.4}, {0.0, 0.0, 0.0}, kBin, -0.1);
