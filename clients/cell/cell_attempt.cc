@@ -289,7 +289,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
     // Replanned: the first motion of the reading at the hold pose, planned about the TCP there.
     const bool replanned = params_.resolution_replan && again && again->resolution_motions_size() > 0;
-    const v1::ResolutionMotion& motion =
+    // A copy: `again` is replaced by the reading after this motion.
+    const v1::ResolutionMotion motion =
         replanned ? again->resolution_motions(0) : analysis.resolution_motions(m);
     const Eigen::Translation3d motion_shift = replanned ? Eigen::Translation3d::Identity() : shift;
     if (const std::optional<std::string> problem =

@@ -2452,13 +2452,8 @@ TEST(CellControllerParamsTest, InvalidValuesNameTheField) {
   // A place surface at no height would let the place pose through unraised.
   params = CellControllerParams{};
   params.place_surface_height = std::numeric_limits<double>::quiet_NaN();
-  try {
-    params.Validate();
-    FAIL() << "expected InvalidArgument";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("place_surface_height: must be finite, got nan"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_THAT([&] { params.Validate(); }, ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
+                                              "place_surface_height: must be finite, got nan")));
 }
 
 }  // namespace
