@@ -259,8 +259,9 @@ std::optional<CellController::AttemptResult> CellController::Conclude(v1::HeldOu
 }
 
 /// Several tubes: carried over the bin's middle (resolution_hold_over_bin), then the resolution
-/// motions in order there, each paused at its tilt (resolution_dwell) and followed by a new reading
-/// at the hold pose; unresolved, back to the lift pose and put back.
+/// motions in order there (with resolution_replan, each after the first planned from the reading
+/// before it, and up to resolution_extra_motions more), each paused at its tilt (resolution_dwell)
+/// and followed by a new reading at the hold pose; unresolved, back to the lift pose and put back.
 CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchResponse& analysis,
                                                       const devices::WrenchReading& reference,
                                                       const devices::WrenchReading& lifted,
@@ -286,9 +287,14 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   // The analysis of the reading after the last motion driven, `again_after` (resolution_replan).
   std::optional<v1::AnalyzeWrenchResponse> again;
   int again_after = -1;
-  for (int m = 0; m < analysis.resolution_motions_size(); ++m) {
+  const int planned = analysis.resolution_motions_size();
+  const int extra =
+      params_.resolution_replan && planned > 0 ? static_cast<int>(params_.resolution_extra_motions) : 0;
+  for (int m = 0; m < planned + extra; ++m) {
     // Replanned: the first motion of the reading at the hold pose, planned about the TCP there.
     const bool replanned = params_.resolution_replan && again && again->resolution_motions_size() > 0;
+    // Past the plan's motions only a reading's own motion goes on (resolution_extra_motions).
+    if (m >= planned && !replanned) break;
     // A copy: `again` is replaced by the reading after this motion.
     const v1::ResolutionMotion motion =
         replanned ? again->resolution_motions(0) : analysis.resolution_motions(m);

@@ -51,6 +51,12 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(resolution_speed, "resolution_speed");
   RequireNonNegativeValue(resolution_wall_margin, "resolution_wall_margin");
   RequireNonNegativeValue(resolution_dwell, "resolution_dwell");
+  // Each motion turns, pauses and reads (about 10 s): more than a few is a mistake, not patience.
+  if (resolution_extra_motions > 10)
+    throw InvalidArgument(
+        fmt::format("cell controller resolution_extra_motions: {} is more than 10 (each is a turn, a pause "
+                    "and a reading)",
+                    resolution_extra_motions));
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");

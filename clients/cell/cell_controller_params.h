@@ -64,6 +64,12 @@ struct CellControllerParams {
   /// (docs/ACCURACY.md). false: the lift plan's motions in order (torque_axis_then_perpendicular's
   /// perpendicular second).
   bool resolution_replan = true;
+  /// With resolution_replan, after the plan's motions: up to this many more while several tubes
+  /// still hang, each the first motion planned from the latest reading at the hold pose. On
+  /// generated set-C bins (`tubepick resolution-trials --extra-motions 2`, the same double picks)
+  /// two more freed 1 of the 13 tangles (2 pvc, 11 rubber) the plan's two left, at about 10 s each
+  /// tangle not freed (docs/ACCURACY.md): off by default. 0 = the plan's motions only; at most 10.
+  std::uint32_t resolution_extra_motions = 0;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.

@@ -22,6 +22,8 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.resolution_hold_over_bin, b.resolution_hold_over_bin);
   EXPECT_EQ(a.resolution_wall_margin, b.resolution_wall_margin);
   EXPECT_EQ(a.resolution_dwell, b.resolution_dwell);
+  EXPECT_EQ(a.resolution_replan, b.resolution_replan);
+  EXPECT_EQ(a.resolution_extra_motions, b.resolution_extra_motions);
   EXPECT_EQ(a.approach_height, b.approach_height);
   EXPECT_EQ(a.transit_clearance, b.transit_clearance);
   EXPECT_EQ(a.release_height, b.release_height);
@@ -137,6 +139,8 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.resolution_hold_over_bin = false;
   p.resolution_wall_margin = 0.09;
   p.resolution_dwell = 0.25;
+  p.resolution_replan = false;
+  p.resolution_extra_motions = 2;
   p.tubes_per_bin = 20;
   p.approach_height = 0.13;
   p.transit_clearance = 0.31;
@@ -236,6 +240,10 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
   EXPECT_NE(
       ParseError("resolution_dwell: -1\n").find("resolution_dwell: must be a non-negative number, got -1"),
       std::string::npos);
+  EXPECT_NE(ParseError("resolution_extra_motions: 11\n")
+                .find("resolution_extra_motions: 11 is more than 10 (each is a turn, a pause and a reading)"),
+            std::string::npos)
+      << ParseError("resolution_extra_motions: 11\n");
   // The pause is one robot call: it must end within the robot's timeout.
   EXPECT_NE(ParseError("resolution_dwell: 5\nrobot_timeout: 5\n")
                 .find("resolution_dwell: 5 s is not below robot_timeout (5 s)"),

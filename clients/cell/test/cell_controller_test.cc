@@ -626,21 +626,38 @@ TEST_F(CellControllerTest, WithoutTheHoldTheRotationTurnsAtTheLiftPose) {
 /// plans its own, 0.6 rad about x there. The second frees one tube either way.
 class ResolutionReplanTest : public CellControllerTest {
  protected:
-  void Drive(bool replan) {
-    params.resolution_replan = replan;
+  /// The double pick and its lift plan's two motions, then `after`: the analyses of the readings
+  /// (`readings`) at the hold pose after each motion driven.
+  void Script(std::vector<v1::AnalyzeWrenchResponse> after, std::vector<devices::WrenchReading> readings) {
     planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
     v1::AnalyzeWrenchResponse multiple = Outcome(v1::HELD_OUTCOME_MULTIPLE, 2.0, 2);
     AddWaypoint(multiple, 0, X_BinTcpLift * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY()));
     AddWaypoint(multiple, 1, X_BinTcpLift * Eigen::AngleAxisd(-0.7, Eigen::Vector3d::UnitY()));
-    const ResolutionHold hold =
-        PlanResolutionHold(devices::AsWrench(Reading(0.1)), devices::AsWrench(Reading(1.3, 0.03, -0.01)),
-                           X_BinTcpLift, cell.bin.inner_size, params.resolution_wall_margin);
-    shift = Eigen::Translation3d(hold.shift_Bin);
-    v1::AnalyzeWrenchResponse still = Outcome(v1::HELD_OUTCOME_MULTIPLE, 1.9, 1);
-    AddWaypoint(still, 0, shift * X_BinTcpLift * Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitX()));
-    planner.wrench_answers = {multiple, still, Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)};
-    ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01), Reading(1.2, -0.02, 0.02), Reading(0.66)};
+    planner.wrench_answers = {multiple};
+    planner.wrench_answers.insert(planner.wrench_answers.end(), after.begin(), after.end());
+    ft.readings = {Reading(0.1), Reading(1.3, 0.03, -0.01)};
+    ft.readings.insert(ft.readings.end(), readings.begin(), readings.end());
     result = Run();
+  }
+  /// Several tubes still, and the motion planned from that reading: `angle` about `axis` at the
+  /// hold pose.
+  v1::AnalyzeWrenchResponse StillSeveral(double ratio, double angle, const Eigen::Vector3d& axis) {
+    v1::AnalyzeWrenchResponse still = Outcome(v1::HELD_OUTCOME_MULTIPLE, ratio, 1);
+    AddWaypoint(still, 0, Shift() * X_BinTcpLift * Eigen::AngleAxisd(angle, axis));
+    return still;
+  }
+  /// Where the double pick is carried before the motions (PlanResolutionHold of the lift reading).
+  Eigen::Translation3d Shift() const {
+    return Eigen::Translation3d(PlanResolutionHold(devices::AsWrench(Reading(0.1)),
+                                                   devices::AsWrench(Reading(1.3, 0.03, -0.01)), X_BinTcpLift,
+                                                   cell.bin.inner_size, params.resolution_wall_margin)
+                                    .shift_Bin);
+  }
+  void Drive(bool replan) {
+    params.resolution_replan = replan;
+    shift = Shift();
+    Script({StillSeveral(1.9, 0.6, Eigen::Vector3d::UnitX()), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)},
+           {Reading(1.2, -0.02, 0.02), Reading(0.66)});
   }
 
   const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));
@@ -678,6 +695,45 @@ TEST_F(ResolutionReplanTest, WithoutReplanTheLiftPlansMotionsRunInOrder) {
   EXPECT_FALSE(a["resolution"].contains("replanned"));
   EXPECT_EQ(a["resolution"]["used"], 2);
   EXPECT_EQ(a["resolution"]["succeeded"], true);
+}
+
+/// Two motions that free nothing, then a third from the reading after the second
+/// (resolution_extra_motions, 1) that frees one tube.
+class ResolutionExtraMotionTest : public ResolutionReplanTest {
+ protected:
+  void DriveExtra(std::uint32_t extra) {
+    params.resolution_extra_motions = extra;
+    shift = Shift();
+    Script({StillSeveral(1.9, 0.6, Eigen::Vector3d::UnitX()),
+            StillSeveral(1.8, -0.5, Eigen::Vector3d::UnitX()), Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)},
+           {Reading(1.2, -0.02, 0.02), Reading(1.1, 0.01, 0.03), Reading(0.66)});
+  }
+  const Eigen::Isometry3d X_BinTcpThird = X_BinTcpLift * Eigen::AngleAxisd(-0.5, Eigen::Vector3d::UnitX());
+};
+
+TEST_F(ResolutionExtraMotionTest, AThirdMotionFromTheReadingAfterTheSecondFreesWhatTwoDidNot) {
+  DriveExtra(1);
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(shift * X_BinTcpThird));
+  // Planned from the reading after the second motion.
+  ASSERT_EQ(planner.wrench_requests.size(), 4u);
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[2].current().torque().y(), 0.03);
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["resolution"]["available"], 2);
+  EXPECT_EQ(a["resolution"]["replanned"], json::array({1, 2}));
+  EXPECT_EQ(a["resolution"]["used"], 3);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+  EXPECT_EQ(a["result"], "picked");
+}
+
+TEST_F(ResolutionExtraMotionTest, WithoutExtraMotionsTheTangleIsPutBackAfterThePlansTwo) {
+  DriveExtra(0);
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_FALSE(robot.Visited(shift * X_BinTcpThird));
+  const json a = Records("attempt").at(0);
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["resolution"]["succeeded"], false);
+  EXPECT_EQ(a["result"], "multiple_returned");
 }
 
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {

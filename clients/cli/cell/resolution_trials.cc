@@ -64,7 +64,8 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::Ce
 // The resolution as the controller runs it: with hold_over_bin, first to the hold pose
 // (PlanResolutionHold) and every waypoint shifted with it; each motion followed by the return to the
 // hold pose and a reading, until the F/T says one tube (or none). With resolution_replan, each
-// motion after the first is the first one planned from that reading at the hold pose.
+// motion after the first is the first one planned from that reading at the hold pose, and up to
+// resolution_extra_motions more follow the plan's.
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
              ResolutionTrial& trial, Wrench* held) {
@@ -79,8 +80,11 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
   trial.hold_shift = shift.translation().norm();
   cell.robot().MoveTo(X_BinTcpHold, c.lift_speed, kLong);
   std::optional<ResolutionPlan> replanned;  // from the reading after the last motion, at the hold pose
-  for (const ResolutionMotion& planned : plan.motions) {
-    const ResolutionMotion& motion = replanned ? replanned->motions.front() : planned;
+  const std::size_t planned = plan.motions.size();
+  const std::size_t extra = c.resolution_replan && planned > 0 ? c.resolution_extra_motions : 0;
+  for (std::size_t m = 0; m < planned + extra; ++m) {
+    if (m >= planned && !replanned) break;  // past the plan's motions only a reading's own goes on
+    const ResolutionMotion& motion = replanned ? replanned->motions.front() : plan.motions[m];
     const Eigen::Translation3d motion_shift = replanned ? Eigen::Translation3d::Identity() : shift;
     ++trial.motions_used;
     for (const ResolutionWaypoint& w : motion.waypoints)
@@ -382,7 +386,7 @@ void RunTrials(const ResolutionTrialsOptions& o) {
   ValidateResolutionTrials(o);
   nlohmann::json json = nlohmann::json::array();
   fmt::print(
-      "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by the 2nd "
+      "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by a later "
       "motion | put back: moved inside, caught on the tool | tubes outside the bin | gripper or robot faults "
       "|\n"
       "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -411,6 +415,7 @@ void RunTrials(const ResolutionTrialsOptions& o) {
                               {"lift", o.trial.lift},
                               {"dwell", o.trial.controller.resolution_dwell},
                               {"replan", o.trial.controller.resolution_replan},
+                              {"extra_motions", o.trial.controller.resolution_extra_motions},
                               {"trials", nlohmann::json::array()}};
         for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
         json.push_back(arm);
@@ -492,6 +497,11 @@ void AddResolutionTrialsCommand(CLI::App& app) {
   cmd->add_option("--replan", o->trial.controller.resolution_replan,
                   "Each motion after the first planned from the reading after the one before, at the hold "
                   "pose (the controller's resolution_replan)")
+      ->capture_default_str();
+  cmd->add_option("--extra-motions", o->trial.controller.resolution_extra_motions,
+                  "With --replan: up to this many more motions after the plan's, each from the latest "
+                  "reading (the controller's resolution_extra_motions)")
+      ->check(CLI::Range(0, 10))
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")
