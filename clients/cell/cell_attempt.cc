@@ -287,14 +287,13 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   // The analysis of the reading after the last motion driven, `again_after` (resolution_replan).
   std::optional<v1::AnalyzeWrenchResponse> again;
   int again_after = -1;
-  const int planned = analysis.resolution_motions_size();
-  const int extra =
-      params_.resolution_replan && planned > 0 ? static_cast<int>(params_.resolution_extra_motions) : 0;
-  for (int m = 0; m < planned + extra; ++m) {
+  const auto planned = static_cast<std::size_t>(analysis.resolution_motions_size());
+  for (int m = 0;; ++m) {
+    const ResolutionMotionSource source =
+        NextResolutionMotion(params_, m, planned, again && again->resolution_motions_size() > 0);
+    if (source == ResolutionMotionSource::kNone) break;
     // Replanned: the first motion of the reading at the hold pose, planned about the TCP there.
-    const bool replanned = params_.resolution_replan && again && again->resolution_motions_size() > 0;
-    // Past the plan's motions only a reading's own motion goes on (resolution_extra_motions).
-    if (m >= planned && !replanned) break;
+    const bool replanned = source == ResolutionMotionSource::kReading;
     // A copy: `again` is replaced by the reading after this motion.
     const v1::ResolutionMotion motion =
         replanned ? again->resolution_motions(0) : analysis.resolution_motions(m);
@@ -304,6 +303,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
       spdlog::info("cell: round {}: resolution motion {} skipped, beyond the robot's limits at {}", round_, m,
                    *problem);
       resolution["beyond_limits"].push_back({{"motion", m}, {"problem", *problem}});
+      // That reading plans nothing else: the plan's next motion, if any, is tried instead.
+      if (replanned) again.reset();
       continue;
     }
     if (replanned) {

@@ -51,12 +51,11 @@ void CellControllerParams::Validate() const {
   RequirePositiveValue(resolution_speed, "resolution_speed");
   RequireNonNegativeValue(resolution_wall_margin, "resolution_wall_margin");
   RequireNonNegativeValue(resolution_dwell, "resolution_dwell");
-  // Each motion turns, pauses and reads (about 10 s): more than a few is a mistake, not patience.
-  if (resolution_extra_motions > 10)
+  if (resolution_extra_motions > kMaxResolutionExtraMotions)
     throw InvalidArgument(
-        fmt::format("cell controller resolution_extra_motions: {} is more than 10 (each is a turn, a pause "
+        fmt::format("cell controller resolution_extra_motions: {} is more than {} (each is a turn, a pause "
                     "and a reading)",
-                    resolution_extra_motions));
+                    resolution_extra_motions, kMaxResolutionExtraMotions));
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");
   RequireNonNegativeValue(release_height, "release_height");
@@ -127,6 +126,14 @@ void CellControllerParams::Validate() const {
                     resolution_dwell, std::chrono::duration<double>(robot_timeout).count()));
   RequirePositiveDuration(gripper_timeout, "gripper_timeout");
   RequirePositiveDuration(ft_timeout, "ft_timeout");
+}
+
+ResolutionMotionSource NextResolutionMotion(const CellControllerParams& params, std::size_t m,
+                                            std::size_t planned, bool reading_has_motion) {
+  const std::size_t extra = params.resolution_replan && planned > 0 ? params.resolution_extra_motions : 0;
+  if (m >= planned + extra) return ResolutionMotionSource::kNone;
+  if (params.resolution_replan && reading_has_motion) return ResolutionMotionSource::kReading;
+  return m < planned ? ResolutionMotionSource::kPlan : ResolutionMotionSource::kNone;
 }
 
 double TransitHeight(const CellControllerParams& params, const CellConfig& cell) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -68,8 +69,11 @@ struct CellControllerParams {
   /// still hang, each the first motion planned from the latest reading at the hold pose. On
   /// generated set-C bins (`tubepick resolution-trials --extra-motions 2`, the same double picks)
   /// two more freed 1 of the 13 tangles (2 pvc, 11 rubber) the plan's two left, at about 10 s each
-  /// tangle not freed (docs/ACCURACY.md): off by default. 0 = the plan's motions only; at most 10.
+  /// tangle not freed (docs/ACCURACY.md): off by default. 0 = the plan's motions only; at most
+  /// kMaxResolutionExtraMotions.
   std::uint32_t resolution_extra_motions = 0;
+  /// Each motion turns, pauses and reads (about 10 s): more than a few is a mistake, not patience.
+  static constexpr std::uint32_t kMaxResolutionExtraMotions = 10;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.
@@ -222,6 +226,21 @@ struct CellControllerParams {
   /// @throws InvalidArgument naming the first bad field and its value.
   void Validate() const;
 };
+
+/// Where a resolution's next motion comes from (NextResolutionMotion).
+enum class ResolutionMotionSource {
+  kPlan,     ///< the lift plan's motion of that index
+  kReading,  ///< the first motion planned from the latest reading at the hold pose
+  kNone,     ///< no more motions: the tubes go back into the bin
+};
+
+/// The resolution's motion number `m` (from 0) after a lift plan of `planned` motions, when the
+/// latest reading at the hold pose (after motion m - 1) did or did not plan a motion of its own:
+/// with resolution_replan that one, else the plan's m-th; past the plan's, up to
+/// resolution_extra_motions more only from readings (none without a plan). The controller
+/// (CellController::Resolve) and `tubepick resolution-trials` both follow it.
+ResolutionMotionSource NextResolutionMotion(const CellControllerParams& params, std::size_t m,
+                                            std::size_t planned, bool reading_has_motion);
 
 /// Home pose of `params` for `cell` (see CellControllerParams::X_BinHome).
 Eigen::Isometry3d HomePose(const CellControllerParams& params, const CellConfig& cell);

@@ -736,6 +736,24 @@ TEST_F(ResolutionExtraMotionTest, WithoutExtraMotionsTheTangleIsPutBackAfterTheP
   EXPECT_EQ(a["result"], "multiple_returned");
 }
 
+TEST_F(ResolutionExtraMotionTest, AReadingsMotionBeyondTheWristLimitEndsTheExtraMotions) {
+  // The reading after the second motion plans a 0.8 rad turn, past a 0.75 rad wrist limit: skipped
+  // once and recorded, and with no other motion from that reading the tangle goes back.
+  robot.limits.max_tilt = 0.75;
+  params.resolution_extra_motions = 3;
+  shift = Shift();
+  const Eigen::Isometry3d X_BinTcpTooFar = X_BinTcpLift * Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitX());
+  Script({StillSeveral(1.9, 0.6, Eigen::Vector3d::UnitX()), StillSeveral(1.8, 0.8, Eigen::Vector3d::UnitX())},
+         {Reading(1.2, -0.02, 0.02), Reading(1.1, 0.01, 0.03), Reading(1.1, 0.01, 0.03)});
+  EXPECT_EQ(result.picks, 0u);
+  EXPECT_FALSE(robot.Visited(shift * X_BinTcpTooFar));
+  const json a = Records("attempt").at(0);
+  ASSERT_EQ(a["resolution"]["beyond_limits"].size(), 1u) << a["resolution"].dump();
+  EXPECT_EQ(a["resolution"]["beyond_limits"][0]["motion"], 2);
+  EXPECT_EQ(a["resolution"]["used"], 2);
+  EXPECT_EQ(a["result"], "multiple_returned");
+}
+
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
   planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
   const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));

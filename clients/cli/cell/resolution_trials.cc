@@ -80,12 +80,13 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
   trial.hold_shift = shift.translation().norm();
   cell.robot().MoveTo(X_BinTcpHold, c.lift_speed, kLong);
   std::optional<ResolutionPlan> replanned;  // from the reading after the last motion, at the hold pose
-  const std::size_t planned = plan.motions.size();
-  const std::size_t extra = c.resolution_replan && planned > 0 ? c.resolution_extra_motions : 0;
-  for (std::size_t m = 0; m < planned + extra; ++m) {
-    if (m >= planned && !replanned) break;  // past the plan's motions only a reading's own goes on
-    const ResolutionMotion& motion = replanned ? replanned->motions.front() : plan.motions[m];
-    const Eigen::Translation3d motion_shift = replanned ? Eigen::Translation3d::Identity() : shift;
+  for (std::size_t m = 0;; ++m) {
+    const cell::ResolutionMotionSource source =
+        cell::NextResolutionMotion(c, m, plan.motions.size(), replanned.has_value());
+    if (source == cell::ResolutionMotionSource::kNone) break;
+    const bool from_reading = source == cell::ResolutionMotionSource::kReading;
+    const ResolutionMotion& motion = from_reading ? replanned->motions.front() : plan.motions[m];
+    const Eigen::Translation3d motion_shift = from_reading ? Eigen::Translation3d::Identity() : shift;
     ++trial.motions_used;
     for (const ResolutionWaypoint& w : motion.waypoints)
       cell.robot().MoveTo(motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
@@ -501,7 +502,7 @@ void AddResolutionTrialsCommand(CLI::App& app) {
   cmd->add_option("--extra-motions", o->trial.controller.resolution_extra_motions,
                   "With --replan: up to this many more motions after the plan's, each from the latest "
                   "reading (the controller's resolution_extra_motions)")
-      ->check(CLI::Range(0, 10))
+      ->check(CLI::Range(0U, cell::CellControllerParams::kMaxResolutionExtraMotions))
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")
