@@ -216,8 +216,10 @@ void RobotiqRtuServer::OnWrite(const std::array<std::uint16_t, robotiq::kRegiste
 bool RobotiqRtuServer::Refresh() {
   {
     std::lock_guard lock(mutex_);
-    if (activation_ != Activation::kActive || motion_running_ || busy_ || !jobs_.empty()) return true;
+    if (activation_ != Activation::kActive || motion_running_ || !jobs_.empty()) return true;
   }
+  // A job that has just published its outcome still holds the device for a moment: wait for it
+  // (lock_wait) rather than answer the state from before the job's end.
   std::unique_lock device = LockWithin(device_lock_, options_.lock_wait);
   if (!device.owns_lock()) return true;  // the last known state
   GripperStatus status;
@@ -262,11 +264,8 @@ void RobotiqRtuServer::RunJobs() {
       if (stop_) return;
       job = jobs_.front();
       jobs_.pop_front();
-      busy_ = true;
     }
     RunJob(job);
-    std::lock_guard lock(mutex_);
-    busy_ = false;
   }
 }
 

@@ -108,7 +108,6 @@ class RobotiqRtuServer {
   std::uint8_t action_ = 0, rpr_ = 0, rsp_ = 0, rfr_ = 0;
   Activation activation_ = Activation::kReset;
   bool motion_running_ = false;
-  bool busy_ = false;  // the worker runs a job
   std::uint8_t gobj_ = 3;
   std::uint8_t gpo_ = 0;
   std::uint8_t fault_ = 0;         // latched by a DeviceFault

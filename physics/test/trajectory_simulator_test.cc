@@ -278,8 +278,10 @@ TEST(TrajectorySimulator, CancelStopsWithinAFewSteps) {
   const auto returned = std::chrono::steady_clock::now();
   canceller.join();
   EXPECT_TRUE(cancelled);
-  // Workers poll every step (well under 1 ms); the bound leaves room for a loaded machine.
-  EXPECT_LT(std::chrono::duration<double>(returned - requested).count(), 0.2);
+  // Workers poll every step (well under 1 ms), so the stop lands at once; unpolled, the lifts would
+  // run for minutes. The bound is that difference, not a latency target: a loaded 2-core CI machine
+  // once took 0.36 s to schedule the return.
+  EXPECT_LT(std::chrono::duration<double>(returned - requested).count(), 5.0);
 }
 
 TEST(TrajectorySimulator, DeadlineStopsTheSimulation) {
