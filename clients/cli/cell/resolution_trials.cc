@@ -66,9 +66,30 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::Ce
 // hold pose and a reading, until the F/T says one tube (or none). With resolution_replan, each
 // motion after the first is the first one planned from that reading at the hold pose, and up to
 // resolution_extra_motions more follow the plan's.
+// TrialParams::lower_to_rest: from the hold pose down in put_back_step steps until less than 1.5 tube
+// weights hang on the tool, not below floor_z; the offset from the hold pose.
+Eigen::Vector3d LowerToRest(SimCell& cell, const Wrench& reference, const Eigen::Isometry3d& X_BinTcpHold,
+                            double floor_z, const cell::CellControllerParams& c) {
+  const double resting = 1.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
+  Eigen::Isometry3d X_BinTcpLow = X_BinTcpHold;
+  X_BinTcpLow.translation().z() = std::min(floor_z, X_BinTcpHold.translation().z());
+  Eigen::Isometry3d X_BinTcpAt = X_BinTcpLow;
+  for (const Eigen::Isometry3d& X_BinTcpStep :
+       cell::DescentSteps(c.put_back_step, X_BinTcpHold, X_BinTcpLow)) {
+    cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
+    if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), X_BinTcpHold.linear()).weight <
+        resting) {
+      X_BinTcpAt = X_BinTcpStep;
+      break;
+    }
+  }
+  cell.robot().MoveTo(X_BinTcpAt, c.lift_speed, kLong);
+  return X_BinTcpAt.translation() - X_BinTcpHold.translation();
+}
+
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
-             const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, const TrialParams& tp,
-             ResolutionTrial& trial, Wrench* held) {
+             const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, double floor_z,
+             const TrialParams& tp, ResolutionTrial& trial, Wrench* held) {
   const cell::CellControllerParams& c = tp.controller;
   const double tube_mass = cell.cell().tube.mass;
   const Eigen::Translation3d shift(
@@ -88,9 +109,13 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
     const ResolutionMotion& motion = from_reading ? replanned->motions.front() : plan.motions[m];
     const Eigen::Translation3d motion_shift = from_reading ? Eigen::Translation3d::Identity() : shift;
     ++trial.motions_used;
+    const Eigen::Translation3d down(tp.lower_to_rest ? LowerToRest(cell, reference, X_BinTcpHold, floor_z, c)
+                                                     : Eigen::Vector3d::Zero());
+    trial.lowered = -down.translation().z();
     for (const ResolutionWaypoint& w : motion.waypoints)
-      cell.robot().MoveTo(motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
+      cell.robot().MoveTo(down * motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (c.resolution_dwell > 0.0) cell.robot().Hold(c.resolution_dwell, kLong);
+    cell.robot().MoveTo(down * X_BinTcpHold, c.resolution_speed, kLong);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     *held = AsWrench(cell.ft_sensor().Read(kLong));
     const HeldCount again = CountHeldTubes(reference, *held, tube_mass, params);
@@ -179,7 +204,8 @@ void LiftAndResolve(SimCell& cell, const TrialGrasp& grasp, const WrenchParams& 
     if (const std::optional<ResolutionPlan> plan =
             PlanResolutionRotation(reference, lifted, X_BinTcpLift, at_lift);
         plan && tp.resolve)
-      Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift, tp, trial, &held);
+      Resolve(cell, *plan, reference, lifted, at_lift, X_BinTcpLift,
+              grasp.X_BinTcp.translation().z() + c.release_height, tp, trial, &held);
     if (trial.freed) return;  // held: the freed tubes fell, counted at the end
     PutBackSeveral(cell, grasp, reference, held, X_BinTcpLift, tp, trial);
     return;
@@ -370,6 +396,7 @@ nlohmann::json TrialJson(const ResolutionTrial& t) {
           {"others_lifted", t.others_lifted},
           {"motions_used", t.motions_used},
           {"hold_shift", t.hold_shift},
+          {"lowered", t.lowered},
           {"freed", t.freed},
           {"tube_held", t.tube_held},
           {"outside_at_start", t.outside_at_start},
@@ -417,6 +444,7 @@ void RunTrials(const ResolutionTrialsOptions& o) {
                               {"dwell", o.trial.controller.resolution_dwell},
                               {"replan", o.trial.controller.resolution_replan},
                               {"extra_motions", o.trial.controller.resolution_extra_motions},
+                              {"lower_to_rest", o.trial.lower_to_rest},
                               {"trials", nlohmann::json::array()}};
         for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
         json.push_back(arm);
@@ -503,6 +531,11 @@ void AddResolutionTrialsCommand(CLI::App& app) {
                   "With --replan: up to this many more motions after the plan's, each from the latest "
                   "reading (the controller's resolution_extra_motions)")
       ->check(CLI::Range(0U, cell::CellControllerParams::kMaxResolutionExtraMotions))
+      ->capture_default_str();
+  cmd->add_option("--lower-to-rest", o->trial.lower_to_rest,
+                  "Each motion turns lower: the tangle let down from the hold pose until less than 1.5 tube "
+                  "weights hang on the tool (the others resting on the heap), turned there, lifted back "
+                  "for the reading")
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")

@@ -95,6 +95,24 @@ TEST(ResolutionTrials, WithoutTheResolutionADoublePickIsPutBackAsTheControllerDo
   EXPECT_EQ(cell.TubesInBin(), 2u);
 }
 
+TEST(ResolutionTrials, LoweredToRestTheTurnComesNoLowerThanTheGraspPlusReleaseHeight) {
+  const SimCellParams params;
+  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+  TrialParams tp;
+  tp.lower_to_rest = true;
+  const ResolutionTrial trial = RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), tp);
+  EXPECT_EQ(trial.fault, "");
+  EXPECT_TRUE(trial.multiple);
+  EXPECT_EQ(trial.others_lifted, 1u);
+  // Let down in put_back_step steps: B, draped over A's middle, keeps more than half its weight on A
+  // even with its legs on the floor, so the descent goes on to its limit, the grasp's height +
+  // release_height, and stops there.
+  EXPECT_NEAR(trial.lowered, tp.lift - tp.controller.release_height, 1e-6);
+  EXPECT_EQ(trial.motions_used, 1u);
+  EXPECT_TRUE(trial.freed);
+  EXPECT_EQ(trial.others_outside, 0u);
+}
+
 std::string ErrorOf(const ResolutionTrialsOptions& o) {
   try {
     ValidateResolutionTrials(o);
