@@ -61,11 +61,18 @@ TEST(ResolutionTrials, ChoosesTheTubeAnotherLiesOnAtItsMiddle) {
   EXPECT_FALSE(ChooseTrialGrasp(cell, {0}).has_value());
 }
 
-TEST(ResolutionTrials, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
+/// A trial in the cell of BridgedTubes, with the torque-axis resolution.
+class BridgedTrialTest : public ::testing::Test {
+ protected:
+  ResolutionTrial Run(const TrialParams& tp) {
+    return RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), tp);
+  }
   const SimCellParams params;
-  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
-  const ResolutionTrial trial =
-      RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), TrialParams{});
+  SimCell cell{params, BridgedTubes(params.cell.tube.radius)};
+};
+
+TEST_F(BridgedTrialTest, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
+  const ResolutionTrial trial = Run(TrialParams{});
   EXPECT_EQ(trial.fault, "");
   EXPECT_EQ(trial.lifts, 1u);
   EXPECT_TRUE(trial.multiple);
@@ -77,12 +84,10 @@ TEST(ResolutionTrials, TheTorqueAxisTiltSlidesABridgedTubeOffIntoTheBin) {
   EXPECT_EQ(cell.TubesInBin(), 1u);  // B fell back; A is held above the bin
 }
 
-TEST(ResolutionTrials, WithoutTheResolutionADoublePickIsPutBackAsTheControllerDoes) {
-  const SimCellParams params;
-  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+TEST_F(BridgedTrialTest, WithoutTheResolutionADoublePickIsPutBackAsTheControllerDoes) {
   TrialParams tp;
   tp.resolve = false;
-  const ResolutionTrial trial = RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), tp);
+  const ResolutionTrial trial = Run(tp);
   EXPECT_EQ(trial.fault, "");
   EXPECT_TRUE(trial.multiple);
   EXPECT_EQ(trial.motions_used, 0u);
@@ -95,12 +100,10 @@ TEST(ResolutionTrials, WithoutTheResolutionADoublePickIsPutBackAsTheControllerDo
   EXPECT_EQ(cell.TubesInBin(), 2u);
 }
 
-TEST(ResolutionTrials, LoweredToRestTheTurnComesNoLowerThanTheGraspPlusReleaseHeight) {
-  const SimCellParams params;
-  SimCell cell(params, BridgedTubes(params.cell.tube.radius));
+TEST_F(BridgedTrialTest, LoweredToRestTheTurnComesNoLowerThanTheGraspPlusReleaseHeight) {
   TrialParams tp;
   tp.lower_to_rest = true;
-  const ResolutionTrial trial = RunResolutionTrial(cell, Resolution(ResolutionVariant::kTorqueAxis), tp);
+  const ResolutionTrial trial = Run(tp);
   EXPECT_EQ(trial.fault, "");
   EXPECT_TRUE(trial.multiple);
   EXPECT_EQ(trial.others_lifted, 1u);
