@@ -61,32 +61,44 @@ bool Grasp(SimCell& cell, const Eigen::Isometry3d& X_BinTcpGrasp, const cell::Ce
          devices::GripperObject::kStoppedClosing;
 }
 
+// Down from X_BinTcpFrom towards X_BinTcpTo (straight below it) in steps of at most `step`
+// (cell::DescentSteps), reading the F/T at each, until less than `weight` newtons hang on the tool;
+// ends at that step, or at X_BinTcpTo. Returns where it ended.
+Eigen::Isometry3d DescendUntilLighter(SimCell& cell, const Wrench& reference,
+                                      const Eigen::Isometry3d& X_BinTcpFrom,
+                                      const Eigen::Isometry3d& X_BinTcpTo, double step, double speed,
+                                      double weight) {
+  Eigen::Isometry3d X_BinTcpEnd = X_BinTcpTo;
+  for (const Eigen::Isometry3d& X_BinTcpStep : cell::DescentSteps(step, X_BinTcpFrom, X_BinTcpTo)) {
+    cell.robot().MoveTo(X_BinTcpStep, speed, kLong);
+    if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), X_BinTcpFrom.linear()).weight <
+        weight) {
+      X_BinTcpEnd = X_BinTcpStep;
+      break;
+    }
+  }
+  cell.robot().MoveTo(X_BinTcpEnd, speed, kLong);
+  return X_BinTcpEnd;
+}
+
+// TrialParams::lower_to_rest: from the hold pose down until less than 1.5 tube weights hang on the
+// tool, not below floor_z; the offset from the hold pose.
+Eigen::Vector3d LowerToRest(SimCell& cell, const Wrench& reference, const Eigen::Isometry3d& X_BinTcpHold,
+                            double floor_z, const cell::CellControllerParams& c) {
+  Eigen::Isometry3d X_BinTcpLow = X_BinTcpHold;
+  X_BinTcpLow.translation().z() = std::min(floor_z, X_BinTcpHold.translation().z());
+  const double resting = 1.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
+  return DescendUntilLighter(cell, reference, X_BinTcpHold, X_BinTcpLow, c.put_back_step, c.lift_speed,
+                             resting)
+             .translation() -
+         X_BinTcpHold.translation();
+}
+
 // The resolution as the controller runs it: with hold_over_bin, first to the hold pose
 // (PlanResolutionHold) and every waypoint shifted with it; each motion followed by the return to the
 // hold pose and a reading, until the F/T says one tube (or none). With resolution_replan, each
 // motion after the first is the first one planned from that reading at the hold pose, and up to
 // resolution_extra_motions more follow the plan's.
-// TrialParams::lower_to_rest: from the hold pose down in put_back_step steps until less than 1.5 tube
-// weights hang on the tool, not below floor_z; the offset from the hold pose.
-Eigen::Vector3d LowerToRest(SimCell& cell, const Wrench& reference, const Eigen::Isometry3d& X_BinTcpHold,
-                            double floor_z, const cell::CellControllerParams& c) {
-  const double resting = 1.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
-  Eigen::Isometry3d X_BinTcpLow = X_BinTcpHold;
-  X_BinTcpLow.translation().z() = std::min(floor_z, X_BinTcpHold.translation().z());
-  Eigen::Isometry3d X_BinTcpAt = X_BinTcpLow;
-  for (const Eigen::Isometry3d& X_BinTcpStep :
-       cell::DescentSteps(c.put_back_step, X_BinTcpHold, X_BinTcpLow)) {
-    cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
-    if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), X_BinTcpHold.linear()).weight <
-        resting) {
-      X_BinTcpAt = X_BinTcpStep;
-      break;
-    }
-  }
-  cell.robot().MoveTo(X_BinTcpAt, c.lift_speed, kLong);
-  return X_BinTcpAt.translation() - X_BinTcpHold.translation();
-}
-
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, double floor_z,
              const TrialParams& tp, ResolutionTrial& trial, Wrench* held) {
@@ -115,7 +127,7 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
     for (const ResolutionWaypoint& w : motion.waypoints)
       cell.robot().MoveTo(down * motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (c.resolution_dwell > 0.0) cell.robot().Hold(c.resolution_dwell, kLong);
-    cell.robot().MoveTo(down * X_BinTcpHold, c.resolution_speed, kLong);
+    if (tp.lower_to_rest) cell.robot().MoveTo(down * X_BinTcpHold, c.resolution_speed, kLong);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     *held = AsWrench(cell.ft_sensor().Read(kLong));
     const HeldCount again = CountHeldTubes(reference, *held, tube_mass, params);
@@ -160,15 +172,8 @@ void PutBackSeveral(SimCell& cell, const TrialGrasp& grasp, const Wrench& refere
   Eigen::Isometry3d X_BinTcpRelease = X_BinTcpPutBack;
   X_BinTcpRelease.translation().z() = grasp.X_BinTcp.translation().z() + c.release_height;
   const double resting = 0.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
-  for (const Eigen::Isometry3d& X_BinTcpStep :
-       cell::DescentSteps(c.put_back_step, X_BinTcpPutBack, X_BinTcpRelease)) {
-    cell.robot().MoveTo(X_BinTcpStep, c.lift_speed, kLong);
-    if (PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight < resting) {
-      X_BinTcpRelease = X_BinTcpStep;
-      break;
-    }
-  }
-  cell.robot().MoveTo(X_BinTcpRelease, c.lift_speed, kLong);
+  X_BinTcpRelease = DescendUntilLighter(cell, reference, X_BinTcpPutBack, X_BinTcpRelease, c.put_back_step,
+                                        c.lift_speed, resting);
   cell.gripper().MoveTo(kTrialOpening, kOpenSpeed, kGripForce, kLong);
   cell.robot().MoveTo(X_BinTcpPutBack, c.approach_speed, kLong);
   trial.caught = PayloadOnTool(reference, AsWrench(cell.ft_sensor().Read(kLong)), R_BinTcp).weight > resting;
