@@ -282,6 +282,10 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
   const Eigen::Translation3d shift(shift_Bin);
   const Eigen::Isometry3d X_BinTcpHold = shift * X_BinTcpLift;
   if (!shift_Bin.isZero()) MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
+  // resolution_rest_load lets the tangle down no lower than a put-back would.
+  Eigen::Isometry3d X_BinTcpLowest = X_BinTcpHold;
+  X_BinTcpLowest.translation().z() = std::min(X_BinTcpHold.translation().z(),
+                                              poses.X_BinTcpGrasp.translation().z() + params_.release_height);
   devices::WrenchReading held = lifted;
   const devices::RobotLimits limits = devices_.robot->Limits();
   // The analysis of the reading after the last motion driven, `again_after` (resolution_replan).
@@ -313,7 +317,8 @@ CellController::AttemptResult CellController::Resolve(const v1::AnalyzeWrenchRes
       resolution["replanned"].push_back(m);
     }
     resolution["used"] = m + 1;
-    again = ResolutionMotion(motion, m, reference, motion_shift, X_BinTcpHold, attempt, &held);
+    again =
+        ResolutionMotion(motion, m, reference, motion_shift, X_BinTcpHold, X_BinTcpLowest, attempt, &held);
     again_after = m;
     if (again->outcome() == v1::HELD_OUTCOME_SINGLE) resolution["succeeded"] = true;
     if (const std::optional<AttemptResult> result =
@@ -364,22 +369,57 @@ v1::AnalyzeWrenchResponse CellController::ResolutionMotion(const v1::ResolutionM
                                                            const devices::WrenchReading& reference,
                                                            const Eigen::Translation3d& shift,
                                                            const Eigen::Isometry3d& X_BinTcpHold,
+                                                           const Eigen::Isometry3d& X_BinTcpLowest,
                                                            Attempt& attempt, devices::WrenchReading* after) {
+  Eigen::Translation3d down = Eigen::Translation3d::Identity();
+  if (params_.resolution_rest_load > 0.0) {
+    down = LowerToRest(X_BinTcpHold, X_BinTcpLowest, reference, attempt);
+    if (const std::optional<std::string> problem =
+            ResolutionReachProblem(devices_.robot->Limits(), motion, m, down * shift, state_)) {
+      spdlog::info(
+          "cell: round {}: resolution motion {} turns at the hold pose: {:.3f} m lower it is beyond the "
+          "robot's limits at {}",
+          round_, m, -down.z(), *problem);
+      attempt.record["resolution"]["lowered_beyond_limits"].push_back({{"motion", m}, {"problem", *problem}});
+      MoveTo(X_BinTcpHold, params_.lift_speed, &attempt);
+      down = Eigen::Translation3d::Identity();
+    }
+  }
   // The planner's waypoints turn about the TCP at the lift pose; the same turns about the TCP at
-  // the hold pose are the waypoints moved by the hold's shift.
+  // the hold pose (or below it) are the waypoints moved by the hold's shift (and the way down).
   for (int w = 0; w < motion.waypoints_size(); ++w) {
     const Eigen::Isometry3d X_BinTcpWaypoint =
-        shift * PlannerPose(motion.waypoints(w).tcp_pose(),
-                            fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
+        down * shift *
+        PlannerPose(motion.waypoints(w).tcp_pose(),
+                    fmt::format("resolution_motions[{}].waypoints[{}].tcp_pose", m, w), state_);
     MoveTo(X_BinTcpWaypoint, params_.resolution_speed, &attempt);
   }
   if (params_.resolution_dwell > 0.0) HoldStill(params_.resolution_dwell, &attempt);
+  if (down.translation().z() < -detail::kSameHeight)
+    MoveTo(down * X_BinTcpHold, params_.resolution_speed, &attempt);
   MoveTo(X_BinTcpHold, params_.resolution_speed, &attempt);
   CheckStillHolding("resolve", attempt);
   *after = ReadWrench();
   const v1::AnalyzeWrenchResponse again = Analyze(reference, *after, X_BinTcpHold, attempt);
   attempt.record["wrench"]["after_resolution"].push_back(AfterResolutionJson(m, motion, *after, again));
   return again;
+}
+
+Eigen::Translation3d CellController::LowerToRest(const Eigen::Isometry3d& X_BinTcpHold,
+                                                 const Eigen::Isometry3d& X_BinTcpLowest,
+                                                 const devices::WrenchReading& reference, Attempt& attempt) {
+  const double below = params_.resolution_rest_load * TubeWeight();
+  const std::optional<Lighter> rest =
+      DescendUntilLighter(X_BinTcpHold, X_BinTcpLowest, reference, below, "resolution_unsettled", attempt);
+  const Eigen::Isometry3d X_BinTcpLow = rest ? rest->X_BinTcp : X_BinTcpLowest;
+  const double lowered = X_BinTcpHold.translation().z() - X_BinTcpLow.translation().z();
+  attempt.record["resolution"]["lowered"].push_back(lowered);
+  spdlog::info(
+      "cell: round {}: turning {:.3f} m below the hold pose, {}", round_, lowered,
+      rest ? fmt::format("where {:.2f} N hang on the tool (under {:.1f} tube weights: the others rest)",
+                         rest->load, params_.resolution_rest_load)
+           : std::string("as low as a put-back goes (the load never got lighter)"));
+  return Eigen::Translation3d(X_BinTcpLow.translation() - X_BinTcpHold.translation());
 }
 
 // ---------------------------------------------------------------- endings
@@ -544,12 +584,11 @@ void CellController::PutBack(const Eigen::Isometry3d& X_BinTcpGrasp, const Eigen
   GoHome(&attempt);
 }
 
-Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpFrom,
-                                          const Eigen::Isometry3d& X_BinTcpRelease,
-                                          const devices::WrenchReading& reference, Attempt& attempt) {
-  const double resting = 0.5 * TubeWeight();
+std::optional<CellController::Lighter> CellController::DescendUntilLighter(
+    const Eigen::Isometry3d& X_BinTcpFrom, const Eigen::Isometry3d& X_BinTcpTo,
+    const devices::WrenchReading& reference, double below, const char* unsettled_key, Attempt& attempt) {
   for (const Eigen::Isometry3d& X_BinTcpStep :
-       DescentSteps(params_.put_back_step, X_BinTcpFrom, X_BinTcpRelease)) {
+       DescentSteps(params_.put_back_step, X_BinTcpFrom, X_BinTcpTo)) {
     MoveTo(X_BinTcpStep, params_.lift_speed, &attempt);
     double weight = 0.0;
     try {
@@ -560,21 +599,29 @@ Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpFrom,
       if (!detail::ReadingsDisagree(fault)) throw;
       // A tangle whose arms touch the heap swings and slides: readings that disagree say nothing
       // of where it rests. Letting it go there dropped three trees out of a simulated bin.
-      attempt.record["wrench"]["put_back_unsettled"].push_back(X_BinTcpStep.translation().z());
+      attempt.record["wrench"][unsettled_key].push_back(X_BinTcpStep.translation().z());
       continue;
     }
-    if (weight >= resting) continue;
-    const double above = X_BinTcpStep.translation().z() - X_BinTcpRelease.translation().z();
-    attempt.record["put_back_touchdown"] = {{"above_release", above}, {"load", weight}};
-    spdlog::info(
-        "cell: round {}: the tubes put back rest on the heap {:.3f} m above the release height "
-        "({:.2f} N still hang on the tool, under half a tube's weight): opening there",
-        round_, above, weight);
-    return X_BinTcpStep;
+    if (weight < below) return Lighter{X_BinTcpStep, weight};
   }
-  if (X_BinTcpRelease.translation().z() < X_BinTcpFrom.translation().z() - detail::kSameHeight)
-    MoveTo(X_BinTcpRelease, params_.lift_speed, &attempt);
-  return X_BinTcpRelease;
+  if (X_BinTcpTo.translation().z() < X_BinTcpFrom.translation().z() - detail::kSameHeight)
+    MoveTo(X_BinTcpTo, params_.lift_speed, &attempt);
+  return std::nullopt;
+}
+
+Eigen::Isometry3d CellController::LayDown(const Eigen::Isometry3d& X_BinTcpFrom,
+                                          const Eigen::Isometry3d& X_BinTcpRelease,
+                                          const devices::WrenchReading& reference, Attempt& attempt) {
+  const std::optional<Lighter> rest = DescendUntilLighter(X_BinTcpFrom, X_BinTcpRelease, reference,
+                                                          0.5 * TubeWeight(), "put_back_unsettled", attempt);
+  if (!rest) return X_BinTcpRelease;
+  const double above = rest->X_BinTcp.translation().z() - X_BinTcpRelease.translation().z();
+  attempt.record["put_back_touchdown"] = {{"above_release", above}, {"load", rest->load}};
+  spdlog::info(
+      "cell: round {}: the tubes put back rest on the heap {:.3f} m above the release height "
+      "({:.2f} N still hang on the tool, under half a tube's weight): opening there",
+      round_, above, rest->load);
+  return rest->X_BinTcp;
 }
 
 void CellController::CheckToolEmpty(const devices::WrenchReading& reference, const std::string& key,

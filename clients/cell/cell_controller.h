@@ -435,12 +435,14 @@ class CellController {
   AttemptResult Resolve(const v1::AnalyzeWrenchResponse& analysis, const devices::WrenchReading& reference,
                         const devices::WrenchReading& lifted, const PlanPoses& poses,
                         const Eigen::Isometry3d& X_BinTcpLift, Attempt& attempt);
-  /// Resolution motion `m` moved by `shift` (lift pose → hold pose), back to the hold pose, a new
-  /// reading (into `after`) and its analysis.
+  /// Resolution motion `m` moved by `shift` (lift pose → hold pose) or, with resolution_rest_load,
+  /// let down first (LowerToRest, no lower than X_BinTcpLowest) and turned there; back to the hold
+  /// pose, a new reading (into `after`) and its analysis.
   v1::AnalyzeWrenchResponse ResolutionMotion(const v1::ResolutionMotion& motion, int m,
                                              const devices::WrenchReading& reference,
                                              const Eigen::Translation3d& shift,
-                                             const Eigen::Isometry3d& X_BinTcpHold, Attempt& attempt,
+                                             const Eigen::Isometry3d& X_BinTcpHold,
+                                             const Eigen::Isometry3d& X_BinTcpLowest, Attempt& attempt,
                                              devices::WrenchReading* after);
   /// Where several tubes not freed are put back: the lift pose, moved inward as far as their centre
   /// of mass (from `held`, the last reading, taken with the lift pose's orientation) needs to lie
@@ -482,6 +484,25 @@ class CellController {
   /// it stopped.
   Eigen::Isometry3d LayDown(const Eigen::Isometry3d& X_BinTcpFrom, const Eigen::Isometry3d& X_BinTcpRelease,
                             const devices::WrenchReading& reference, Attempt& attempt);
+  /// Where a descent got lighter, and the load that still hung on the tool there, N.
+  struct Lighter {
+    Eigen::Isometry3d X_BinTcp;
+    double load = 0.0;
+  };
+  /// From X_BinTcpFrom (where the TCP is) straight down towards X_BinTcpTo in steps of put_back_step,
+  /// reading the F/T after each, until less than `below` newtons hang on the tool; readings that
+  /// disagree are recorded (the step's height under record["wrench"][unsettled_key]) and go on down.
+  /// The step where it got lighter; nullopt when it got to X_BinTcpTo without.
+  std::optional<Lighter> DescendUntilLighter(const Eigen::Isometry3d& X_BinTcpFrom,
+                                             const Eigen::Isometry3d& X_BinTcpTo,
+                                             const devices::WrenchReading& reference, double below,
+                                             const char* unsettled_key, Attempt& attempt);
+  /// resolution_rest_load: from the hold pose down towards X_BinTcpLowest (DescendUntilLighter)
+  /// until less than that many tube weights hang on the tool; the way down from the hold pose,
+  /// recorded under record["resolution"]["lowered"].
+  Eigen::Translation3d LowerToRest(const Eigen::Isometry3d& X_BinTcpHold,
+                                   const Eigen::Isometry3d& X_BinTcpLowest,
+                                   const devices::WrenchReading& reference, Attempt& attempt);
   /// Before the tool goes home empty-handed (after a failed grasp, a put-back, a nudge, the place):
   /// a reading against `reference` (the same gripper opening and, but for a turn about the
   /// vertical, orientation) that must weigh nothing, into record["wrench"][key]. A tube caught on

@@ -126,6 +126,8 @@ void DescribeMotionFields(Visit& v, CellControllerParams& p) {
     "a motion that left several tubes: the next one planned from the reading after it, at the hold pose");
   v("resolution_extra_motions", p.resolution_extra_motions,
     "with resolution_replan: up to this many more motions after the plan's, each from the latest reading");
+  v("resolution_rest_load", p.resolution_rest_load,
+    "tube weights: each motion let down until less than this hangs on the tool; 0 = at the hold pose");
   v("approach_height", p.approach_height, "m, pre-grasp back from the grasp");
   v("transit_clearance", p.transit_clearance, "m above the bin's wall top");
   v("release_height", p.release_height, "m above the grasp to put back several tubes");

@@ -74,6 +74,18 @@ struct CellControllerParams {
   std::uint32_t resolution_extra_motions = 0;
   /// Each motion turns, pauses and reads (about 10 s): more than a few is a mistake, not patience.
   static constexpr std::uint32_t kMaxResolutionExtraMotions = 10;
+  /// Before each resolution motion, the tangle is let down from the hold pose in put_back_step
+  /// steps, reading the F/T at each, until less than this many tube weights hang on the tool (the
+  /// tubes hooked on the grasped one resting on the heap), no lower than release_height above the
+  /// grasp; the motion turns there, and the tool goes back up to the hold pose for the reading. A
+  /// hose hanging wholly from the grasped one keeps its hook under its own weight; resting, it
+  /// slides off. On generated set-C bins (`tubepick resolution-trials --rest-load 1.5`, the same
+  /// double picks either way) 1.5 freed 27 of 47 rubber tangles against 20 turned at the hold pose
+  /// (9 won, 2 lost), but 9 of 12 pvc ones against 11: a stiff tree resting on the heap stays in the
+  /// hook (docs/ACCURACY.md). 0 = turn at the hold pose (the default; pvc); otherwise more than 1
+  /// (the grasped tube alone weighs one) and at most kMaxResolutionRestLoad.
+  double resolution_rest_load = 0.0;
+  static constexpr double kMaxResolutionRestLoad = 10.0;
   /// Pre-grasp pose: this far back from the grasp along the approach direction, metres.
   double approach_height = 0.10;
   /// Transit moves happen at least this far above the bin's wall top, metres.

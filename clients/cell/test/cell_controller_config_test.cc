@@ -24,6 +24,7 @@ void ExpectSame(const CellControllerParams& a, const CellControllerParams& b) {
   EXPECT_EQ(a.resolution_dwell, b.resolution_dwell);
   EXPECT_EQ(a.resolution_replan, b.resolution_replan);
   EXPECT_EQ(a.resolution_extra_motions, b.resolution_extra_motions);
+  EXPECT_EQ(a.resolution_rest_load, b.resolution_rest_load);
   EXPECT_EQ(a.approach_height, b.approach_height);
   EXPECT_EQ(a.transit_clearance, b.transit_clearance);
   EXPECT_EQ(a.release_height, b.release_height);
@@ -141,6 +142,7 @@ TEST(CellControllerConfigTest, DumpOfModifiedParamsParsesBackToThem) {
   p.resolution_dwell = 0.25;
   p.resolution_replan = false;
   p.resolution_extra_motions = 2;
+  p.resolution_rest_load = 1.5;
   p.tubes_per_bin = 20;
   p.approach_height = 0.13;
   p.transit_clearance = 0.31;
@@ -244,6 +246,12 @@ TEST(CellControllerConfigTest, OutOfRangeValuesNameTheFieldAndTheValue) {
                 .find("resolution_extra_motions: 11 is more than 10 (each is a turn, a pause and a reading)"),
             std::string::npos)
       << ParseError("resolution_extra_motions: 11\n");
+  // At or under one tube weight the grasped tube alone would do: never lighter, always the lowest.
+  EXPECT_NE(ParseError("resolution_rest_load: 0.8\n")
+                .find("resolution_rest_load: 0.8 tube weights; 0 (turn at the hold pose) or more than 1"),
+            std::string::npos)
+      << ParseError("resolution_rest_load: 0.8\n");
+  EXPECT_NE(ParseError("resolution_rest_load: 12\n").find("and at most 10"), std::string::npos);
   // The pause is one robot call: it must end within the robot's timeout.
   EXPECT_NE(ParseError("resolution_dwell: 5\nrobot_timeout: 5\n")
                 .find("resolution_dwell: 5 s is not below robot_timeout (5 s)"),

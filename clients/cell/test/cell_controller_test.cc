@@ -754,6 +754,57 @@ TEST_F(ResolutionExtraMotionTest, AReadingsMotionBeyondTheWristLimitEndsTheExtra
   EXPECT_EQ(a["result"], "multiple_returned");
 }
 
+/// resolution_rest_load: the tangle is let down from the hold pose in put_back_step steps (0.37 m
+/// to the grasp + release_height in four of 0.0925 m here) until less than 1.5 tube weights hang on
+/// the tool, and turned there.
+class ResolutionRestLoadTest : public ResolutionReplanTest {
+ protected:
+  void SetUp() override {
+    ResolutionReplanTest::SetUp();
+    params.resolution_rest_load = 1.5;
+    params.put_back_step = 0.1;
+    ft.tcp = &robot.X_BinTcp;
+    shift = Shift();
+  }
+  /// The lift plan's first motion, `down` below the hold pose.
+  Eigen::Isometry3d Turned(double down) const {
+    return Eigen::Translation3d(0.0, 0.0, -down) * shift * X_BinTcpLift *
+           Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY());
+  }
+  const double step = (0.4 - params.release_height) / 4.0;
+};
+
+TEST_F(ResolutionRestLoadTest, TheTangleIsTurnedWhereTheHeapTakesTheOthers) {
+  ASSERT_NEAR(X_BinTcpLift.translation().z() - p_Bin_grasp.z(), 0.4, 1e-12);
+  // The heap takes the load from two steps down; one step down both tubes still hang.
+  ft.rests_below_z = X_BinTcpLift.translation().z() - 1.5 * step;
+  Script({Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)}, {Reading(1.3, 0.03, -0.01), Reading(0.66)});
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(Turned(2.0 * step)));
+  EXPECT_FALSE(robot.Visited(Turned(0.0)));
+  EXPECT_FALSE(robot.Visited(Turned(step)));
+  // Read at the hold pose again, not where it turned.
+  ASSERT_EQ(planner.wrench_requests.size(), 2u);
+  EXPECT_TRUE(
+      FromProto(planner.wrench_requests[1].tcp_pose(), "tcp_pose").isApprox(shift * X_BinTcpLift, kTol));
+  const json a = Records("attempt").at(0);
+  ASSERT_EQ(a["resolution"]["lowered"].size(), 1u);
+  EXPECT_NEAR(a["resolution"]["lowered"][0].get<double>(), 2.0 * step, 1e-9);
+  EXPECT_EQ(a["resolution"]["succeeded"], true);
+}
+
+TEST_F(ResolutionRestLoadTest, ALoadThatNeverGetsLighterIsTurnedNoLowerThanAPutBackGoes) {
+  // Two tubes' weight at every step: down to the grasp + release_height, turned there.
+  Script({Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)},
+         {Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01),
+          Reading(1.3, 0.03, -0.01), Reading(0.66)});
+  EXPECT_EQ(result.picks, 1u) << result.message;
+  EXPECT_TRUE(robot.Visited(Turned(4.0 * step)));
+  EXPECT_NEAR(Turned(4.0 * step).translation().z(), p_Bin_grasp.z() + params.release_height, 1e-9);
+  const json a = Records("attempt").at(0);
+  EXPECT_NEAR(a["resolution"]["lowered"][0].get<double>(), 0.4 - params.release_height, 1e-9);
+}
+
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
   planner.plan_answers.push_back(Plans({MakePlan(5, p_Bin_grasp)}, 4));
   const Eigen::Isometry3d X_BinTcpLift = DownPose(p_Bin_grasp + Eigen::Vector3d(0, 0, 0.4));

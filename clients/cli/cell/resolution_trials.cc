@@ -81,13 +81,13 @@ Eigen::Isometry3d DescendUntilLighter(SimCell& cell, const Wrench& reference,
   return X_BinTcpEnd;
 }
 
-// TrialParams::lower_to_rest: from the hold pose down until less than 1.5 tube weights hang on the
-// tool, not below floor_z; the offset from the hold pose.
+// The controller's resolution_rest_load: from the hold pose down until less than that many tube
+// weights hang on the tool, not below floor_z; the offset from the hold pose.
 Eigen::Vector3d LowerToRest(SimCell& cell, const Wrench& reference, const Eigen::Isometry3d& X_BinTcpHold,
                             double floor_z, const cell::CellControllerParams& c) {
   Eigen::Isometry3d X_BinTcpLow = X_BinTcpHold;
   X_BinTcpLow.translation().z() = std::min(floor_z, X_BinTcpHold.translation().z());
-  const double resting = 1.5 * cell.cell().tube.mass * WrenchParams{}.gravity;
+  const double resting = c.resolution_rest_load * cell.cell().tube.mass * WrenchParams{}.gravity;
   return DescendUntilLighter(cell, reference, X_BinTcpHold, X_BinTcpLow, c.put_back_step, c.lift_speed,
                              resting)
              .translation() -
@@ -121,13 +121,14 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
     const ResolutionMotion& motion = from_reading ? replanned->motions.front() : plan.motions[m];
     const Eigen::Translation3d motion_shift = from_reading ? Eigen::Translation3d::Identity() : shift;
     ++trial.motions_used;
-    const Eigen::Translation3d down(tp.lower_to_rest ? LowerToRest(cell, reference, X_BinTcpHold, floor_z, c)
-                                                     : Eigen::Vector3d::Zero());
+    const Eigen::Translation3d down(c.resolution_rest_load > 0.0
+                                        ? LowerToRest(cell, reference, X_BinTcpHold, floor_z, c)
+                                        : Eigen::Vector3d::Zero());
     trial.lowered = -down.translation().z();
     for (const ResolutionWaypoint& w : motion.waypoints)
       cell.robot().MoveTo(down * motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
     if (c.resolution_dwell > 0.0) cell.robot().Hold(c.resolution_dwell, kLong);
-    if (tp.lower_to_rest) cell.robot().MoveTo(down * X_BinTcpHold, c.resolution_speed, kLong);
+    if (c.resolution_rest_load > 0.0) cell.robot().MoveTo(down * X_BinTcpHold, c.resolution_speed, kLong);
     cell.robot().MoveTo(X_BinTcpHold, c.resolution_speed, kLong);
     *held = AsWrench(cell.ft_sensor().Read(kLong));
     const HeldCount again = CountHeldTubes(reference, *held, tube_mass, params);
@@ -449,7 +450,7 @@ void RunTrials(const ResolutionTrialsOptions& o) {
                               {"dwell", o.trial.controller.resolution_dwell},
                               {"replan", o.trial.controller.resolution_replan},
                               {"extra_motions", o.trial.controller.resolution_extra_motions},
-                              {"lower_to_rest", o.trial.lower_to_rest},
+                              {"rest_load", o.trial.controller.resolution_rest_load},
                               {"trials", nlohmann::json::array()}};
         for (const ResolutionTrial& t : trials) arm["trials"].push_back(TrialJson(t));
         json.push_back(arm);
@@ -537,10 +538,11 @@ void AddResolutionTrialsCommand(CLI::App& app) {
                   "reading (the controller's resolution_extra_motions)")
       ->check(CLI::Range(0U, cell::CellControllerParams::kMaxResolutionExtraMotions))
       ->capture_default_str();
-  cmd->add_option("--lower-to-rest", o->trial.lower_to_rest,
-                  "Each motion turns lower: the tangle let down from the hold pose until less than 1.5 tube "
-                  "weights hang on the tool (the others resting on the heap), turned there, lifted back "
-                  "for the reading")
+  cmd->add_option("--rest-load", o->trial.controller.resolution_rest_load,
+                  "Each motion turns lower: the tangle let down from the hold pose until less than this many "
+                  "tube weights hang on the tool (the others resting on the heap), turned there, lifted back "
+                  "for the reading; 0 = at the hold pose (the controller's resolution_rest_load)")
+      ->check(CLI::Range(0.0, cell::CellControllerParams::kMaxResolutionRestLoad))
       ->capture_default_str();
   cmd->add_option("--resolve", o->trial.resolve,
                   "Run the resolution; false: every double pick is put back at once (the put-back alone)")

@@ -46,7 +46,8 @@ struct ResolutionTrial {
   std::uint32_t motions_used = 0;
   /// How far the payload was moved to the hold pose, metres.
   double hold_shift = 0.0;
-  /// With TrialParams::lower_to_rest: how far below the hold pose the last motion turned, metres.
+  /// With the controller's resolution_rest_load: how far below the hold pose the last motion
+  /// turned, metres.
   double lowered = 0.0;
   /// The F/T said one tube after a motion.
   bool freed = false;
@@ -74,16 +75,14 @@ struct TrialParams {
   std::uint32_t max_lifts = 6;
   /// Run the resolution on a double pick; false: put it back at once (measures the put-back alone).
   bool resolve = true;
-  /// Each motion turns lower: the tangle first let down from the hold pose in put_back_step steps
-  /// until less than 1.5 tube weights hang on the tool (the tubes hooked on the grasped one rest on
-  /// the heap), at most to the grasp's height + release_height; the motion's turn there, then back
-  /// up to the hold pose for the reading. false: the turn at the hold pose (the controller).
-  bool lower_to_rest = false;
   /// The controller's speeds, approach and release heights, resolution hold
   /// (resolution_hold_over_bin: the payload brought over the bin's middle, PlanResolutionHold,
   /// before the rotation, the TCP resolution_wall_margin inside the walls), the pause at each
-  /// motion's tilt (resolution_dwell) and the motions after the first planned from the reading
-  /// before them (resolution_replan).
+  /// motion's tilt (resolution_dwell), the motions after the first planned from the reading
+  /// before them (resolution_replan, resolution_extra_motions) and where they turn
+  /// (resolution_rest_load: let down from the hold pose in put_back_step steps until less than that
+  /// many tube weights hang on the tool, at most to the grasp's height + release_height, turned
+  /// there, back up to the hold pose for the reading).
   cell::CellControllerParams controller;
 };
 

@@ -102,7 +102,7 @@ TEST_F(BridgedTrialTest, WithoutTheResolutionADoublePickIsPutBackAsTheController
 
 TEST_F(BridgedTrialTest, LoweredToRestTheTurnComesNoLowerThanTheGraspPlusReleaseHeight) {
   TrialParams tp;
-  tp.lower_to_rest = true;
+  tp.controller.resolution_rest_load = 1.5;
   const ResolutionTrial trial = Run(tp);
   EXPECT_EQ(trial.fault, "");
   EXPECT_TRUE(trial.multiple);
