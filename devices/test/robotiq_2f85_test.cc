@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <regex>
 #include <string>
 
 #include "devices/testing/robotiq_fake.h"
@@ -165,7 +166,12 @@ TEST(Robotiq2F85, ALostRequestIsSentAgainWithinTheCallsTimeout) {
   } catch (const DeviceTimeout& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("no answer to status read on"), std::string::npos) << what;
-    EXPECT_NE(what.find("(3 tries)"), std::string::npos) << what;
+    // 350 ms at 100 ms per unanswered try: three on a quiet machine; a loaded one fits two (a CI run
+    // beside other work gave "(2 tries)"). At least one resend, and never more than fit.
+    std::smatch tries;
+    ASSERT_TRUE(std::regex_search(what, tries, std::regex(R"(\((\d+) tries\))"))) << what;
+    EXPECT_GE(std::stoi(tries[1].str()), 2) << what;
+    EXPECT_LE(std::stoi(tries[1].str()), 4) << what;
   }
 }
 
