@@ -787,6 +787,7 @@ TEST_F(ResolutionRestLoadTest, TheTangleIsTurnedWhereTheHeapTakesTheOthers) {
   ASSERT_EQ(planner.wrench_requests.size(), 2u);
   EXPECT_TRUE(
       FromProto(planner.wrench_requests[1].tcp_pose(), "tcp_pose").isApprox(shift * X_BinTcpLift, kTol));
+  EXPECT_DOUBLE_EQ(planner.wrench_requests[1].current().force().z(), 0.66);
   const json a = Records("attempt").at(0);
   ASSERT_EQ(a["resolution"]["lowered"].size(), 1u);
   EXPECT_NEAR(a["resolution"]["lowered"][0].get<double>(), 2.0 * step, 1e-9);
@@ -794,15 +795,18 @@ TEST_F(ResolutionRestLoadTest, TheTangleIsTurnedWhereTheHeapTakesTheOthers) {
 }
 
 TEST_F(ResolutionRestLoadTest, ALoadThatNeverGetsLighterIsTurnedNoLowerThanAPutBackGoes) {
-  // Two tubes' weight at every step: down to the grasp + release_height, turned there.
+  // Two tubes' weight at each of the three steps between: on down to the grasp + release_height (not
+  // read there), turned there.
   Script({Outcome(v1::HELD_OUTCOME_SINGLE, 1.0)},
-         {Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01),
-          Reading(1.3, 0.03, -0.01), Reading(0.66)});
+         {Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01), Reading(1.3, 0.03, -0.01), Reading(0.66)});
   EXPECT_EQ(result.picks, 1u) << result.message;
   EXPECT_TRUE(robot.Visited(Turned(4.0 * step)));
   EXPECT_NEAR(Turned(4.0 * step).translation().z(), p_Bin_grasp.z() + params.release_height, 1e-9);
   const json a = Records("attempt").at(0);
   EXPECT_NEAR(a["resolution"]["lowered"][0].get<double>(), 0.4 - params.release_height, 1e-9);
+  // The reading after the turn is the one at the hold pose (every scripted reading used, none left).
+  EXPECT_TRUE(ft.readings.empty());
+  EXPECT_DOUBLE_EQ(planner.wrench_requests.at(1).current().force().z(), 0.66);
 }
 
 TEST_F(CellControllerTest, MultipleAfterEveryResolutionIsLoweredIntoTheBinOpenedAndRescanned) {
