@@ -60,8 +60,7 @@ void CellControllerParams::Validate() const {
       !(resolution_rest_load > 1.0 && resolution_rest_load <= kMaxResolutionRestLoad))
     throw InvalidArgument(
         fmt::format("cell controller resolution_rest_load: {} tube weights; 0 (turn at the hold pose) or "
-                    "more than 1 (the "
-                    "grasped tube alone weighs one) and at most {}",
+                    "more than 1 (the grasped tube alone weighs one) and at most {}",
                     resolution_rest_load, kMaxResolutionRestLoad));
   RequireNonNegativeValue(approach_height, "approach_height");
   RequireNonNegativeValue(transit_clearance, "transit_clearance");

@@ -496,6 +496,14 @@ void ValidateResolutionTrials(const ResolutionTrialsOptions& o) {
   if (!(o.trial.controller.resolution_wall_margin >= 0.0))
     throw InvalidArgument(fmt::format("--wall-margin: {} m (inside the bin walls, at least 0)",
                                       o.trial.controller.resolution_wall_margin));
+  // The controller's own rule for resolution_rest_load (0, or over one tube weight).
+  cell::CellControllerParams rest_load;
+  rest_load.resolution_rest_load = o.trial.controller.resolution_rest_load;
+  try {
+    rest_load.Validate();
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--rest-load: ") + e.what());
+  }
 }
 
 void AddResolutionTrialsCommand(CLI::App& app) {

@@ -150,6 +150,8 @@ TEST(ResolutionTrials, EveryBadOptionIsRefusedByNameBeforeATrialRuns) {
               HasSubstr("--put-back-margin: -0.2 m"));
   EXPECT_THAT(with([](auto& o) { o.trial.controller.put_back_step = -0.01; }),
               HasSubstr("--put-back-step: -0.01 m"));
+  EXPECT_THAT(with([](auto& o) { o.trial.controller.resolution_rest_load = 0.5; }),
+              HasSubstr("--rest-load: cell controller resolution_rest_load: 0.5 tube weights"));
 }
 
 // PlanPick from a queue; AnalyzeWrench is the real analysis (the fast profile's, as the server's).
