@@ -94,11 +94,25 @@ Eigen::Vector3d LowerToRest(SimCell& cell, const Wrench& reference, const Eigen:
          X_BinTcpHold.translation();
 }
 
+// Why a resolution motion turned about the TCP `shift` from where it was planned leaves the arm's
+// reach or wrist limits (a tool tilted at the grasp turned further), or nullopt: the controller
+// skips such a motion (CellController's ResolutionReachProblem) rather than drive into the stop.
+std::optional<std::string> ReachProblem(SimCell& cell, const ResolutionMotion& motion,
+                                        const Eigen::Translation3d& shift) {
+  const devices::RobotLimits limits = cell.robot().Limits();
+  for (std::size_t w = 0; w < motion.waypoints.size(); ++w) {
+    if (std::string problem = limits.Problem(shift * motion.waypoints[w].X_BinTcpRotated); !problem.empty())
+      return fmt::format("waypoint {}: {}", w, problem);
+  }
+  return std::nullopt;
+}
+
 // The resolution as the controller runs it: with hold_over_bin, first to the hold pose
 // (PlanResolutionHold) and every waypoint shifted with it; each motion followed by the return to the
 // hold pose and a reading, until the F/T says one tube (or none). With resolution_replan, each
 // motion after the first is the first one planned from that reading at the hold pose, and up to
-// resolution_extra_motions more follow the plan's.
+// resolution_extra_motions more follow the plan's. A motion beyond the robot's limits is skipped, and
+// one beyond them only where it was let down turns at the hold pose, as the controller does.
 void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference, const Wrench& lifted,
              const WrenchParams& params, const Eigen::Isometry3d& X_BinTcpLift, double floor_z,
              const TrialParams& tp, ResolutionTrial& trial, Wrench* held) {
@@ -120,10 +134,20 @@ void Resolve(SimCell& cell, const ResolutionPlan& plan, const Wrench& reference,
     const bool from_reading = source == cell::ResolutionMotionSource::kReading;
     const ResolutionMotion& motion = from_reading ? replanned->motions.front() : plan.motions[m];
     const Eigen::Translation3d motion_shift = from_reading ? Eigen::Translation3d::Identity() : shift;
+    if (ReachProblem(cell, motion, motion_shift)) {
+      ++trial.beyond_limits;
+      if (from_reading) replanned.reset();  // that reading plans nothing else: the plan's next motion
+      continue;
+    }
     ++trial.motions_used;
-    const Eigen::Translation3d down(c.resolution_rest_load > 0.0
-                                        ? LowerToRest(cell, reference, X_BinTcpHold, floor_z, c)
-                                        : Eigen::Vector3d::Zero());
+    Eigen::Translation3d down(c.resolution_rest_load > 0.0
+                                  ? LowerToRest(cell, reference, X_BinTcpHold, floor_z, c)
+                                  : Eigen::Vector3d::Zero());
+    if (c.resolution_rest_load > 0.0 && ReachProblem(cell, motion, down * motion_shift)) {
+      ++trial.lowered_beyond_limits;
+      cell.robot().MoveTo(X_BinTcpHold, c.lift_speed, kLong);
+      down = Eigen::Translation3d::Identity();
+    }
     trial.lowered = -down.translation().z();
     for (const ResolutionWaypoint& w : motion.waypoints)
       cell.robot().MoveTo(down * motion_shift * w.X_BinTcpRotated, c.resolution_speed, kLong);
@@ -345,7 +369,7 @@ namespace {
 // Counts over the bins of one material, variant and angle.
 struct ArmSummary {
   std::uint32_t bins = 0, lifts = 0, multiple = 0, freed = 0, second_motion = 0, outside = 0, faults = 0;
-  std::uint32_t put_back = 0, moved_inside = 0, caught = 0;
+  std::uint32_t put_back = 0, moved_inside = 0, caught = 0, beyond_limits = 0;
 };
 
 std::vector<ResolutionTrial> RunArm(const SimCellParams& base, const WrenchParams& wrench,
@@ -380,6 +404,7 @@ ArmSummary Summarise(const std::vector<ResolutionTrial>& trials) {
   for (const ResolutionTrial& t : trials) {
     s.lifts += t.lifts;
     s.faults += !t.fault.empty();
+    s.beyond_limits += t.beyond_limits;
     s.outside += t.others_outside;
     if (!t.multiple) continue;
     ++s.multiple;
@@ -403,6 +428,8 @@ nlohmann::json TrialJson(const ResolutionTrial& t) {
           {"motions_used", t.motions_used},
           {"hold_shift", t.hold_shift},
           {"lowered", t.lowered},
+          {"beyond_limits", t.beyond_limits},
+          {"lowered_beyond_limits", t.lowered_beyond_limits},
           {"freed", t.freed},
           {"tube_held", t.tube_held},
           {"outside_at_start", t.outside_at_start},
@@ -422,8 +449,8 @@ void RunTrials(const ResolutionTrialsOptions& o) {
   fmt::print(
       "| material | shapes | variant | angle | bins | lifts | double picks (F/T) | freed | freed by a later "
       "motion | put back: moved inside, caught on the tool | tubes outside the bin | gripper or robot faults "
-      "|\n"
-      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| motions skipped, beyond the robot's limits |\n"
+      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const std::string& material_name : o.materials) {
     const Material material = devices::sim::ParseMaterial(material_name, "--materials");
     SimCellParams params = SimCellParams::Thesis(material, o.tubes, o.seed);
@@ -437,10 +464,10 @@ void RunTrials(const ResolutionTrialsOptions& o) {
         wrench.Validate();
         const std::vector<ResolutionTrial> trials = RunArm(params, wrench, o);
         const ArmSummary s = Summarise(trials);
-        fmt::print("| {} | {} | {} | {:.0f}° | {} | {} | {} | {} ({}) | {} | {}: {}, {} | {} | {} |\n",
+        fmt::print("| {} | {} | {} | {:.0f}° | {} | {} | {} | {} ({}) | {} | {}: {}, {} | {} | {} | {} |\n",
                    material_name, shapes, variant, angle, s.bins, s.lifts, s.multiple, s.freed,
                    Percent(s.freed, s.multiple), s.second_motion, s.put_back, s.moved_inside, s.caught,
-                   s.outside, s.faults);
+                   s.outside, s.faults, s.beyond_limits);
         nlohmann::json arm = {{"material", material_name},
                               {"shapes", shapes},
                               {"variant", variant},

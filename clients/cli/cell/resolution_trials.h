@@ -49,6 +49,11 @@ struct ResolutionTrial {
   /// With the controller's resolution_rest_load: how far below the hold pose the last motion
   /// turned, metres.
   double lowered = 0.0;
+  /// Motions skipped because a waypoint lay beyond the robot's reach or wrist limits, as the
+  /// controller skips them; and motions turned at the hold pose because they were beyond them only
+  /// where the tangle was let down to (resolution_rest_load).
+  std::uint32_t beyond_limits = 0;
+  std::uint32_t lowered_beyond_limits = 0;
   /// The F/T said one tube after a motion.
   bool freed = false;
   /// Ground truth after 2 s of rest at the end (holding the tube when freed, else after putting

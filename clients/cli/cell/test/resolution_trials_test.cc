@@ -116,6 +116,21 @@ TEST_F(BridgedTrialTest, LoweredToRestTheTurnComesNoLowerThanTheGraspPlusRelease
   EXPECT_EQ(trial.others_outside, 0u);
 }
 
+TEST_F(BridgedTrialTest, AMotionBeyondTheRobotsWristLimitIsSkippedAndTheDoublePickPutBack) {
+  WrenchParams wrench = Resolution(ResolutionVariant::kTorqueAxis);
+  wrench.rotation_angle = 75.0 * M_PI / 180.0;  // the simulated arm tilts the tool 60° at most
+  const ResolutionTrial trial = RunResolutionTrial(cell, wrench, TrialParams{});
+  // Skipped as the controller skips it, not driven into the arm's joint-limit stop (a fault).
+  EXPECT_EQ(trial.fault, "");
+  EXPECT_TRUE(trial.multiple);
+  EXPECT_EQ(trial.beyond_limits, 1u);
+  EXPECT_EQ(trial.motions_used, 0u);
+  EXPECT_FALSE(trial.freed);
+  EXPECT_FALSE(trial.tube_held);  // put back
+  EXPECT_EQ(trial.others_outside, 0u);
+  EXPECT_EQ(cell.TubesInBin(), 2u);
+}
+
 std::string ErrorOf(const ResolutionTrialsOptions& o) {
   try {
     ValidateResolutionTrials(o);
